@@ -1,0 +1,275 @@
+"""What the user sets: the model's constants and the distribution of pinning distances.
+
+Both are small frozen dataclasses that validate themselves on construction, so that a
+bad parameter fails at once and names itself.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+__all__ = [
+    "JumpDistribution",
+    "Exponential",
+    "Deterministic",
+    "Tabulated",
+    "Model",
+]
+
+# Integer codes that the numba kernels dispatch on.
+KIND_EXPONENTIAL = 0
+KIND_DETERMINISTIC = 1
+KIND_TABULATED = 2
+
+
+def _require(condition: bool, message: str) -> None:
+    if not condition:
+        raise ValueError(message)
+
+
+def _finite_positive(name: str, value: float) -> float:
+    value = float(value)
+    _require(math.isfinite(value) and value > 0.0, f"{name} must be a finite number > 0, got {value!r}")
+    return value
+
+
+def _finite_nonnegative(name: str, value: float) -> float:
+    value = float(value)
+    _require(math.isfinite(value) and value >= 0.0, f"{name} must be a finite number >= 0, got {value!r}")
+    return value
+
+
+class JumpDistribution:
+    """The distribution g(z) of distances z > 0 between consecutive pinning wells.
+
+    Subclasses provide the cumulative distribution, its first two moments, a quantile
+    function for sampling and a support bound.  ``kind`` is the integer code the numba
+    kernels dispatch on.
+    """
+
+    kind: int
+    zbar: float
+
+    def cdf(self, z: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def quantile(self, u: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @property
+    def mean(self) -> float:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @property
+    def second_moment(self) -> float:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @property
+    def z_max(self) -> float:  # pragma: no cover - abstract
+        """An upper bound of the support (where the remaining mass is below 1e-16)."""
+        raise NotImplementedError
+
+    @property
+    def mean_residual(self) -> float:
+        r"""The mean overshoot of a renewal process with these increments,
+        :math:`\langle z^2\rangle / (2\langle z\rangle)`."""
+        return self.second_moment / (2.0 * self.mean)
+
+    def sample(self, rng: np.random.Generator, size: int | tuple[int, ...]) -> np.ndarray:
+        """Draw pinning distances by inverting the cumulative distribution."""
+        return self.quantile(rng.random(size))
+
+
+@dataclass(frozen=True)
+class Exponential(JumpDistribution):
+    r"""Exponential distances with mean parameter ``zbar`` and an upper cutoff.
+
+    .. math:: g(z) = \frac{1}{\bar z}\, e^{-z/\bar z}\, \Theta(z)\,\Theta(z_c - z) / (1 - e^{-z_c/\bar z})
+
+    The paper (Appendix B) uses the cutoff :math:`z_c = 10`; the normalisation
+    :math:`1 - e^{-z_c/\bar z}` is kept so that g is a probability density for any cutoff.
+    """
+
+    zbar: float = 0.1
+    cutoff: float = 10.0
+    kind: int = field(default=KIND_EXPONENTIAL, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        _finite_positive("zbar", self.zbar)
+        _require(
+            math.isfinite(float(self.cutoff)) and float(self.cutoff) > float(self.zbar),
+            f"cutoff must be a finite number > zbar = {self.zbar!r}, got {self.cutoff!r}",
+        )
+
+    @property
+    def _norm(self) -> float:
+        return -math.expm1(-self.cutoff / self.zbar)
+
+    def cdf(self, z):
+        z = np.clip(np.asarray(z, dtype=float), 0.0, self.cutoff)
+        return -np.expm1(-z / self.zbar) / self._norm
+
+    def quantile(self, u):
+        u = np.asarray(u, dtype=float)
+        return -self.zbar * np.log1p(-u * self._norm)
+
+    @property
+    def mean(self) -> float:
+        c, b = self.cutoff, self.zbar
+        tail = math.exp(-c / b)
+        return (b - (c + b) * tail) / self._norm
+
+    @property
+    def second_moment(self) -> float:
+        c, b = self.cutoff, self.zbar
+        tail = math.exp(-c / b)
+        return (2.0 * b * b - (c * c + 2.0 * c * b + 2.0 * b * b) * tail) / self._norm
+
+    @property
+    def z_max(self) -> float:
+        return min(self.cutoff, self.zbar * 37.0)
+
+
+@dataclass(frozen=True)
+class Deterministic(JumpDistribution):
+    r"""All pinning wells at the same distance: :math:`g(z) = \delta(z - \bar z)`."""
+
+    zbar: float = 0.1
+    kind: int = field(default=KIND_DETERMINISTIC, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        _finite_positive("zbar", self.zbar)
+
+    def cdf(self, z):
+        return (np.asarray(z, dtype=float) >= self.zbar).astype(float)
+
+    def quantile(self, u):
+        return np.full(np.shape(u), self.zbar)
+
+    @property
+    def mean(self) -> float:
+        return self.zbar
+
+    @property
+    def second_moment(self) -> float:
+        return self.zbar * self.zbar
+
+    @property
+    def z_max(self) -> float:
+        return self.zbar
+
+
+@dataclass(frozen=True)
+class Tabulated(JumpDistribution):
+    """A distribution the user supplies as a density ``pdf`` on ``[0, z_max]``.
+
+    The density is tabulated on ``n`` points, normalised, and its cumulative distribution
+    and quantile function are built by the trapezoidal rule; ``zbar`` is its mean.
+    """
+
+    pdf: Callable[[np.ndarray], np.ndarray] = field(repr=False, default=None)  # type: ignore[assignment]
+    support_max: float = 1.0
+    n: int = 4097
+    kind: int = field(default=KIND_TABULATED, init=False, repr=False)
+    zbar: float = field(init=False)
+    _z: np.ndarray = field(init=False, repr=False, compare=False)
+    _cdf: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        _require(callable(self.pdf), "pdf must be a callable returning g(z) >= 0 for an array z")
+        _finite_positive("support_max", self.support_max)
+        _require(int(self.n) >= 17, f"n must be an integer >= 17, got {self.n!r}")
+        z = np.linspace(0.0, float(self.support_max), int(self.n))
+        g = np.asarray(self.pdf(z), dtype=float)
+        _require(g.shape == z.shape, "pdf must return an array of the same shape as its argument")
+        _require(bool(np.all(np.isfinite(g))) and bool(np.all(g >= 0.0)), "pdf must be finite and >= 0 on [0, support_max]")
+        cdf = np.concatenate([[0.0], np.cumsum(0.5 * (g[1:] + g[:-1]) * np.diff(z))])
+        _require(cdf[-1] > 0.0, "pdf must have positive mass on [0, support_max]")
+        cdf /= cdf[-1]
+        object.__setattr__(self, "_z", z)
+        object.__setattr__(self, "_cdf", cdf)
+        object.__setattr__(self, "zbar", float(self.mean))
+
+    def cdf(self, z):
+        return np.interp(np.asarray(z, dtype=float), self._z, self._cdf, left=0.0, right=1.0)
+
+    def quantile(self, u):
+        # The cumulative distribution may be flat where g vanishes: interpolate on its
+        # strictly increasing part.
+        keep = np.concatenate([[True], np.diff(self._cdf) > 0.0])
+        return np.interp(np.asarray(u, dtype=float), self._cdf[keep], self._z[keep])
+
+    @property
+    def mean(self) -> float:
+        # E[z] = integral of (1 - F)
+        s = 1.0 - self._cdf
+        return float(np.sum(0.5 * (s[1:] + s[:-1]) * np.diff(self._z)))
+
+    @property
+    def second_moment(self) -> float:
+        # E[z^2] = integral of 2 z (1 - F)
+        s = 2.0 * self._z * (1.0 - self._cdf)
+        return float(np.sum(0.5 * (s[1:] + s[:-1]) * np.diff(self._z)))
+
+    @property
+    def z_max(self) -> float:
+        return float(self.support_max)
+
+
+@dataclass(frozen=True)
+class Model:
+    r"""The mean-field viscoelastic depinning model, Eqs. (1)-(2) of Landes, Rosso & Jagla (2015).
+
+    .. math::
+        \eta_0 \partial_t h_i &= k_0 (w - h_i) + (k_1 + k_2)(\bar h - h_i) - k_2 u_i + f_i^{dis}(h_i) \\
+        \eta_u \partial_t u_i &= k_2 (\bar h - h_i) - k_2 u_i
+
+    in the narrow-wells limit with a constant threshold ``f_th`` and pinning distances
+    drawn from ``jumps``; avalanches are instantaneous (:math:`\tau_0 \to 0`).
+
+    Parameters
+    ----------
+    k0 : driving-spring stiffness, > 0.
+    k1 : elastic coupling between blocks, >= 0.
+    k2 : stiffness of the viscoelastic (spring + dashpot) coupling, >= 0.
+    eta_u : dashpot viscosity, > 0; the relaxation rate is ``gamma = k2 / eta_u``.
+    f_th : pinning threshold, > 0.
+    jumps : distribution of pinning distances; default exponential with mean 0.1 and
+        cutoff 10 (the paper's Fig. 4 parameters).
+    """
+
+    k0: float
+    k1: float = 0.1
+    k2: float = 0.9
+    eta_u: float = 1.0
+    f_th: float = 1.0
+    jumps: JumpDistribution = field(default_factory=lambda: Exponential(0.1, 10.0))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "k0", _finite_positive("k0", self.k0))
+        object.__setattr__(self, "k1", _finite_nonnegative("k1", self.k1))
+        object.__setattr__(self, "k2", _finite_nonnegative("k2", self.k2))
+        object.__setattr__(self, "eta_u", _finite_positive("eta_u", self.eta_u))
+        object.__setattr__(self, "f_th", _finite_positive("f_th", self.f_th))
+        _require(
+            isinstance(self.jumps, JumpDistribution),
+            f"jumps must be a JumpDistribution (Exponential, Deterministic or Tabulated), got {type(self.jumps).__name__}",
+        )
+
+    @property
+    def kappa(self) -> float:
+        """Total stiffness seen by a block that jumps, ``k0 + k1 + k2``."""
+        return self.k0 + self.k1 + self.k2
+
+    @property
+    def gamma(self) -> float:
+        """Viscoelastic relaxation rate ``k2 / eta_u`` (inverse of the paper's tau_u)."""
+        return self.k2 / self.eta_u
+
+    @property
+    def zbar(self) -> float:
+        """Mean pinning distance of ``jumps``."""
+        return self.jumps.mean
