@@ -1,0 +1,347 @@
+"""The discretised density P(delta_F, delta_R) and the loop that advances it.
+
+:class:`Grid` owns the arrays the numba kernels in :mod:`micro._kernels` work on: it
+allocates them, grows them when the density spreads, builds the initial densities and
+calls :func:`micro._kernels.advance` until a requested time, collecting what it records.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _kernels as K
+from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
+
+__all__ = ["Grid", "GridSettings"]
+
+log = logging.getLogger(__name__)
+
+#: Mass of the jump-length distribution left beyond the grid's last column.
+TAIL_MASS = 1e-14
+
+
+@dataclass(frozen=True)
+class GridSettings:
+    """Numerical settings of the Fokker-Planck grid.
+
+    Parameters
+    ----------
+    eps : bin width of delta_F and delta_R.  Must resolve a mean jump,
+        ``eps <= kappa * zbar / 4``.
+    theta_shift : largest shift of delta_F per time step, in bins (0 < theta_shift <= 1).
+    theta_relax : largest typical relaxation of delta_R per time step, in bins.
+    dt_max : largest time step.
+    """
+
+    eps: float = 2e-3
+    theta_shift: float = 0.5
+    theta_relax: float = 0.5
+    dt_max: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("eps", "theta_shift", "theta_relax", "dt_max"):
+            v = float(getattr(self, name))
+            if not (math.isfinite(v) and v > 0.0):
+                raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        if self.theta_shift > 1.0:
+            raise ValueError(f"theta_shift must be in (0, 1], got {self.theta_shift!r}")
+
+    def check(self, model: Model) -> None:
+        """Check that ``eps`` resolves the model's mean jump ``kappa * zbar``."""
+        limit = model.kappa * model.zbar / 4.0
+        if self.eps > limit:
+            raise ValueError(
+                f"eps must be <= kappa*zbar/4 = {limit:.4g} (4 bins per mean jump) for this model, got {self.eps!r}"
+            )
+
+
+def _landing_parameters(model: Model, eps: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Distribution constants for the kernels, the tabulated CDF and the largest landing displacement."""
+    kappa = model.kappa
+    jumps = model.jumps
+    dp = np.zeros(3)
+    if jumps.kind == KIND_EXPONENTIAL:
+        scale = jumps.zbar  # the exponential's scale parameter
+        dp[:] = (kappa * scale, kappa * jumps.cutoff, -math.expm1(-jumps.cutoff / scale))
+        s_max = kappa * min(jumps.cutoff, scale * math.log(1.0 / TAIL_MASS))
+        table = np.zeros(2)
+    elif jumps.kind == KIND_DETERMINISTIC:
+        dp[0] = kappa * jumps.zbar
+        s_max = kappa * jumps.zbar + eps
+        table = np.zeros(2)
+    else:
+        z_max = jumps.z_max
+        n = 1 + int(min(1 << 22, max(4096, 64 * z_max * kappa / eps)))
+        z = np.linspace(0.0, z_max, n)
+        table = np.ascontiguousarray(jumps.cdf(z), dtype=float)
+        dp[:] = (kappa * z_max / (n - 1), kappa * z_max, 0.0)
+        s_max = kappa * z_max
+    return dp, table, s_max
+
+
+class Grid:
+    """The density of (delta_F, delta_R) on a grid of bin ``eps``, with its scalar state.
+
+    Parameters
+    ----------
+    model : the model.
+    settings : numerical settings.
+    initial : ``"frozen"`` (all delta_R = 0 and delta distributed as the overshoot of a
+        renewal process with increments kappa z: the V -> infinity state) or
+        ``"relaxed"`` (every dashpot relaxed and delta distributed with increments
+        (k0 + k1) z: the V -> 0 state).
+    """
+
+    def __init__(self, model: Model, settings: GridSettings, initial: str = "frozen") -> None:
+        settings.check(model)
+        if initial not in ("frozen", "relaxed"):
+            raise ValueError(f"initial must be 'frozen' or 'relaxed', got {initial!r}")
+        self.model = model
+        self.settings = settings
+        eps = settings.eps
+        dp, self.table, s_max = _landing_parameters(model, eps)
+        self.cols_needed = int(math.ceil(s_max / eps)) + 4
+        prm = np.zeros(K.N_PARAM)
+        prm[K.P_K0] = model.k0
+        prm[K.P_K1] = model.k1
+        prm[K.P_K2] = model.k2
+        prm[K.P_KAPPA] = model.kappa
+        prm[K.P_GAMMA] = model.gamma
+        prm[K.P_FTH] = model.f_th
+        prm[K.P_EPS] = eps
+        prm[K.P_ZMEAN] = model.zbar
+        prm[K.P_KIND] = model.jumps.kind
+        prm[K.P_D0 : K.P_D2 + 1] = dp
+        prm[K.P_THETA_S] = settings.theta_shift
+        prm[K.P_THETA_R] = settings.theta_relax
+        prm[K.P_DT_MAX] = settings.dt_max
+        prm[K.P_SHOCK] = 8.0
+        self.prm = prm
+        self.ist = np.zeros(K.N_ISTATE, dtype=np.int64)
+        self.fst = np.zeros(K.N_FSTATE)
+        self._build_initial(initial)
+
+    # ----------------------------------------------------------------------------- set-up
+    def _allocate(self, nrow: int, ncol: int) -> None:
+        self.bufM = np.zeros((2, nrow, ncol))
+        self.bufW = np.zeros((2, nrow, ncol))
+        self.bufO = np.zeros((2, nrow, ncol))
+        self.bufchi = np.zeros((2, nrow), dtype=np.int64)
+        self.bufclo = np.full((2, nrow), ncol, dtype=np.int64)
+        self.ex_m = np.zeros(nrow)
+        self.ex_w = np.zeros(nrow)
+        self.ex_d = np.zeros(nrow)
+
+    def _build_initial(self, initial: str) -> None:
+        model, eps = self.model, self.settings.eps
+        stiffness = model.kappa if initial == "frozen" else model.k0 + model.k1
+        # density of delta: overshoot of a renewal process with increments stiffness * z
+        n_sub = 8
+        s_max = stiffness * model.jumps.z_max
+        n_bins = int(math.ceil(s_max / eps)) + 1
+        delta = (np.arange(n_bins * n_sub) + 0.5) * (eps / n_sub)
+        density = 1.0 - np.asarray(model.jumps.cdf(delta / stiffness))
+        weight = density / density.sum()
+        mean_delta = float(np.sum(weight * delta))
+        if initial == "frozen":
+            y = np.zeros_like(delta)
+        else:
+            y = model.k2 / (model.k0 + model.k1) * (mean_delta - delta)
+        j = np.floor(y / eps + 0.5).astype(np.int64)
+        eta = y / eps - j
+        d = np.floor(delta / eps - eta).astype(np.int64)
+        jbase = int(j.min()) - 4
+        nrow = int(j.max()) - jbase + 5
+        off = 3
+        ncol = max(2 * self.cols_needed, int(d.max()) + 1) + 16
+        self._allocate(nrow, ncol)
+        r = j - jbase
+        c = off + d
+        M = self.bufM[0]
+        W = self.bufW[0]
+        np.add.at(M, (r, c), weight)
+        np.add.at(W, (r, c), weight * eta)
+        np.add.at(self.bufO[0], (r, c), weight)
+        occupied = M > 0.0
+        for row in range(nrow):
+            cols = np.flatnonzero(occupied[row])
+            if cols.size:
+                self.bufclo[0, row] = cols[0]
+                self.bufchi[0, row] = cols[-1] + 1
+        rows = np.flatnonzero(occupied.any(axis=1))
+        ist, fst = self.ist, self.fst
+        ist[K.I_OFF] = off
+        ist[K.I_JBASE] = jbase
+        ist[K.I_RLO] = rows[0]
+        ist[K.I_RHI] = rows[-1] + 1
+        ist[K.I_CUR] = 0
+        # x (delta_F) centre of every cell, from its bin
+        k = d - j
+        mean_x = float(np.sum(weight * (k + 0.5) * eps))
+        fst[K.F_MEANX] = mean_x
+        fst[K.F_MASS] = 1.0
+        fst[K.F_SIGMA] = model.f_th - mean_x
+        fst[K.F_DISP] = float(np.sum(weight * np.abs(model.k2 / model.kappa * (mean_x - (k + 0.5) * eps) - y)))
+        fst[K.F_WIN_MIN] = fst[K.F_SIGMA]
+        fst[K.F_WIN_MAX] = fst[K.F_SIGMA]
+
+    # ----------------------------------------------------------------------------- state
+    @property
+    def t(self) -> float:
+        return float(self.fst[K.F_T])
+
+    @property
+    def sigma(self) -> float:
+        """Stress ``k0 (w - hbar)``."""
+        return float(self.fst[K.F_SIGMA])
+
+    @property
+    def sigma_grid(self) -> float:
+        """Stress from the grid, ``f_th - <delta_F>`` (equal to :attr:`sigma` up to discretisation)."""
+        return float(self.model.f_th - self.fst[K.F_MEANX])
+
+    def density(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current cell masses, delta_R offsets ``eta`` and filled fractions ``omega``."""
+        cur = int(self.ist[K.I_CUR])
+        M = self.bufM[cur]
+        safe = np.where(M > 0.0, M, 1.0)
+        eta = np.where(M > 0.0, self.bufW[cur] / safe, 0.0)
+        omega = np.where(M > 0.0, self.bufO[cur] / safe, 0.0)
+        return M, eta, omega
+
+    def mass(self) -> float:
+        return float(self.density()[0].sum())
+
+    def min_mass(self) -> float:
+        """Most negative cell mass (0 if the density is non-negative everywhere)."""
+        return float(min(self.density()[0].min(), self.fst[K.F_NEG]))
+
+    def cells(self) -> dict[str, np.ndarray]:
+        """Occupied cells as arrays: mass, delta_F centre, delta_R, delta."""
+        M, eta, omega = self.density()
+        eps = self.settings.eps
+        r, c = np.nonzero(M)
+        j = r + int(self.ist[K.I_JBASE])
+        d = c - int(self.ist[K.I_OFF])
+        phi = float(self.fst[K.F_PHI])
+        e = eta[r, c]
+        x = (d - j + 1 - phi - 0.5 * omega[r, c]) * eps
+        y = (j + e) * eps
+        return {"mass": M[r, c], "delta_F": x, "delta_R": y, "delta": x + y}
+
+    # ----------------------------------------------------------------------------- growth
+    def _grow_rows(self) -> None:
+        cur = int(self.ist[K.I_CUR])
+        M = self.bufM[cur]
+        chi, clo = self.bufchi[cur], self.bufclo[cur]
+        # lam = 0 bounds every relaxation (delta_R moves between its value and its target)
+        rmin, rmax, _ = K.bounds_after_relax(self.ist, self.fst, self.prm, 0.0, clo, chi)
+        nrow = M.shape[0]
+        add_lo = max(0, 2 - rmin) + 8 + nrow // 4
+        add_hi = max(0, rmax - (nrow - 3)) + 8 + nrow // 4
+        new_rows = nrow + add_lo + add_hi
+        self._reshape(new_rows, M.shape[1], add_lo, 0)
+        log.debug("grid rows %d -> %d", nrow, new_rows)
+
+    def _recentre_or_grow_cols(self) -> None:
+        cur = int(self.ist[K.I_CUR])
+        M = self.bufM[cur]
+        chi, clo = self.bufchi[cur], self.bufclo[cur]
+        off = int(self.ist[K.I_OFF])
+        rlo, rhi = int(self.ist[K.I_RLO]), int(self.ist[K.I_RHI])
+        occupied = chi[rlo:rhi] > clo[rlo:rhi]
+        c_first = min(int(clo[rlo:rhi][occupied].min()) if occupied.any() else off, off - 2)
+        c_last = max(int(chi[rlo:rhi][occupied].max()) if occupied.any() else off, off + self.cols_needed)
+        ncol = M.shape[1]
+        width = c_last - c_first
+        # live columns need the window plus room for relaxation to move mass up
+        need = width + self.cols_needed // 2 + 16
+        new_ncol = ncol if need <= ncol else int(need * 1.5)
+        shift = c_first - 4
+        self._reshape(M.shape[0], new_ncol, 0, -shift)
+        log.debug("grid columns %d -> %d, shifted by %d", ncol, new_ncol, -shift)
+
+    def _reshape(self, nrow: int, ncol: int, row_shift: int, col_shift: int) -> None:
+        """Copy the live buffer into arrays of shape (nrow, ncol), moving rows down by
+        ``row_shift`` and columns right by ``col_shift``."""
+        cur = int(self.ist[K.I_CUR])
+        oldM, oldW, oldO = self.bufM[cur], self.bufW[cur], self.bufO[cur]
+        oldchi, oldclo = self.bufchi[cur], self.bufclo[cur]
+        r_old, c_old = np.nonzero(oldM)
+        vals_m = oldM[r_old, c_old]
+        vals_w = oldW[r_old, c_old]
+        vals_o = oldO[r_old, c_old]
+        self._allocate(nrow, ncol)
+        r_new = r_old + row_shift
+        c_new = c_old + col_shift
+        if c_new.size and (c_new.min() < 0 or c_new.max() >= ncol or r_new.min() < 0 or r_new.max() >= nrow):
+            raise RuntimeError("internal error: grid reshape would drop mass")
+        self.bufM[0][r_new, c_new] = vals_m
+        self.bufW[0][r_new, c_new] = vals_w
+        self.bufO[0][r_new, c_new] = vals_o
+        nr_old = oldchi.shape[0]
+        for r in range(nr_old):
+            if oldchi[r] > oldclo[r]:
+                self.bufchi[0, r + row_shift] = oldchi[r] + col_shift
+                self.bufclo[0, r + row_shift] = oldclo[r] + col_shift
+        self.ist[K.I_CUR] = 0
+        self.ist[K.I_JBASE] -= row_shift
+        self.ist[K.I_RLO] += row_shift
+        self.ist[K.I_RHI] += row_shift
+        self.ist[K.I_OFF] += col_shift
+
+    # ----------------------------------------------------------------------------- stepping
+    def advance(
+        self,
+        velocity: float,
+        t_stop: float,
+        record_interval: float,
+        *,
+        stop_after_shocks: int = 0,
+        shock_bins: float = 8.0,
+        max_steps: int = 1 << 62,
+    ) -> tuple[np.ndarray, np.ndarray, int]:
+        """Advance to ``t_stop`` at constant drive velocity.
+
+        Returns ``(records, shocks, code)``: records are rows ``t, sigma, min, max, mean``
+        per ``record_interval``; shocks are rows ``t, sigma_before, sigma_after, shift``
+        for every step whose cascade shifted more than ``shock_bins`` bins.
+        """
+        self.prm[K.P_SHOCK] = shock_bins
+        records: list[np.ndarray] = []
+        shocks: list[np.ndarray] = []
+        rec = np.zeros((4096, 5))
+        shk = np.zeros((1024, 4))
+        seen_shocks = 0
+        if self.fst[K.F_WIN_START] + record_interval <= self.fst[K.F_T]:
+            self.fst[K.F_WIN_START] = self.fst[K.F_T]
+        while True:
+            self.ist[K.I_NREC] = 0
+            self.ist[K.I_NSHOCK] = 0
+            remaining_shocks = stop_after_shocks - seen_shocks if stop_after_shocks > 0 else 0
+            code = K.advance(
+                self.bufM, self.bufW, self.bufO, self.bufchi, self.bufclo, self.ist, self.fst, self.prm,
+                self.table, self.ex_m, self.ex_w, self.ex_d, float(velocity), float(t_stop), max_steps,
+                self.cols_needed, rec, float(record_interval), shk, remaining_shocks,
+            )
+            n_rec = min(int(self.ist[K.I_NREC]), rec.shape[0])
+            n_shk = min(int(self.ist[K.I_NSHOCK]), shk.shape[0])
+            if n_rec:
+                records.append(rec[:n_rec].copy())
+            if n_shk:
+                shocks.append(shk[:n_shk].copy())
+            seen_shocks += n_shk
+            if code == K.NEED_ROWS:
+                self._grow_rows()
+            elif code == K.NEED_COLS:
+                self._recentre_or_grow_cols()
+            elif code in (K.RECORDS_FULL, K.SHOCKS_FULL):
+                continue
+            else:
+                break
+        out_rec = np.concatenate(records) if records else np.zeros((0, 5))
+        out_shk = np.concatenate(shocks) if shocks else np.zeros((0, 4))
+        return out_rec, out_shk, code
