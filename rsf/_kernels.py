@@ -3,12 +3,12 @@ decision and the right-hand sides handed to CVODE.
 
 Conventions (see ``docs/rsf.md``):
 
-* a steady-state law is a jitted function ``law(v, p) -> (mu_ss(v) - mu_ref, W(v))`` where
-  ``p`` is a float64 parameter array, ``mu_ref`` a constant reference level kept outside
-  the kernels (the large-velocity limit where there is one, so that the tiny frictions
-  just above it keep full relative precision after long slips), and
-  :math:`W(v) = -v\,\mathrm{d}\mu_{ss}/\mathrm{d}v` is the velocity-weakening rate
-  (positive for velocity weakening); all frictions in the kernels are relative to
+* a steady-state law is evaluated by ``law_eval(v, p) -> (mu_ss(v) - mu_ref, W(v))``:
+  ``p[0]`` is the law's integer code (``KIND_*``) and ``p[1:]`` its parameters;
+  ``mu_ref`` is a constant kept outside the kernels (the large-velocity limit where there
+  is one, so that frictions just above it keep full relative precision after long
+  slips); :math:`W(v) = -v\,\mathrm{d}\mu_{ss}/\mathrm{d}v` is the velocity-weakening
+  rate (positive for velocity weakening).  All frictions in the kernels are relative to
   ``mu_ref``;
 * the friction of the paper's model is :math:`\phi(\theta) = \mu_{ss}(D_c/\theta)` (Eq. 11),
   and :math:`u = D_c/\theta` is the "state velocity", so that
@@ -16,9 +16,10 @@ Conventions (see ``docs/rsf.md``):
 * with :math:`K = k_0 D_c` the slide velocity is :math:`v = N/D` with
   :math:`N = K V - u W(u)` and :math:`D = K - W(u)`.
 
-Every kernel here calls only the ``law`` argument and other functions of this module, so
-that :func:`python_twins` can build a pure-Python copy of the whole set (used for laws
-numba cannot compile, and to check the compiled kernels against their plain source).
+The kernels take plain arrays and floats only (no function arguments), so that numba's
+on-disk cache (``cache=True``) serves the command line.  :func:`kernel_namespace` builds
+the same set around another ``law_eval`` (a user's law), compiled or as pure Python; the
+pure-Python set is also the plain reference the compiled kernels are tested against.
 """
 from __future__ import annotations
 
@@ -38,6 +39,13 @@ _GL_W = np.array([
     0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
     0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763,
 ])
+
+# Law codes (p[0] of a law's parameter array).
+KIND_HYPERBOLIC = 0
+KIND_VISCOELASTIC = 1
+KIND_LOG = 2
+KIND_TABLE = 3
+KIND_USER = 4
 
 # Phase codes returned by :func:`decide`.
 STICK = 0
@@ -133,18 +141,34 @@ def table_law(v, p):
     return y, -dydx
 
 
+@njit(cache=True)
+def law_eval(v, p):
+    """Evaluate the law coded in ``p[0]`` with parameters ``p[1:]``: (mu_ss - mu_ref, W)."""
+    kind = int(p[0])
+    q = p[1:]
+    if kind == KIND_HYPERBOLIC:
+        return hyperbolic_law(v, q)
+    if kind == KIND_VISCOELASTIC:
+        return viscoelastic_law(v, q)
+    if kind == KIND_LOG:
+        return log_law(v, q)
+    if kind == KIND_TABLE:
+        return table_law(v, q)
+    return math.nan, math.nan
+
+
 # --------------------------------------------------------------------------------------
 # the friction phi(theta) and accurate differences of it
 # --------------------------------------------------------------------------------------
 @njit(cache=True)
-def phi_w(law, p, theta, Dc):
+def phi_w(p, theta, Dc):
     r"""Return :math:`\phi(\theta) = \mu_{ss}(D_c/\theta)` (Eq. 11, relative to ``mu_ref``)
     and :math:`W(D_c/\theta)`."""
-    return law(Dc / theta, p)
+    return law_eval(Dc / theta, p)
 
 
 @njit(cache=True)
-def dphi(law, p, theta_a, log_ratio, Dc):
+def dphi(p, theta_a, log_ratio, Dc):
     r"""Return :math:`\phi(\theta_a e^{r}) - \phi(\theta_a)` for ``r = log_ratio``.
 
     For :math:`|r| \le 1/4` this is the 8-point Gauss-Legendre value of
@@ -157,13 +181,13 @@ def dphi(law, p, theta_a, log_ratio, Dc):
         u_a = Dc / theta_a
         for i in range(8):
             rho = half * (1.0 + _GL_X[i])
-            total += _GL_W[i] * law(u_a * math.exp(-rho), p)[1]
+            total += _GL_W[i] * law_eval(u_a * math.exp(-rho), p)[1]
         return half * total
-    return law(Dc / (theta_a * math.exp(log_ratio)), p)[0] - law(Dc / theta_a, p)[0]
+    return law_eval(Dc / (theta_a * math.exp(log_ratio)), p)[0] - law_eval(Dc / theta_a, p)[0]
 
 
 @njit(cache=True)
-def phase_fn(kind, law, p, x, c):
+def phase_fn(kind, p, x, c):
     r"""The scalar functions whose first root ends a stick (``kind = 0``) or a slip
     (``kind = 1``).
 
@@ -176,21 +200,21 @@ def phase_fn(kind, law, p, x, c):
     with :math:`h_0 = g_0 = \sigma_0 - \phi(\theta_0)`.
     """
     if kind == 0:
-        return c[0] + c[2] * x - dphi(law, p, c[1], math.log1p(x / c[1]), c[3])
-    return c[0] - c[2] * x - dphi(law, p, c[1], -x, c[3])
+        return c[0] + c[2] * x - dphi(p, c[1], math.log1p(x / c[1]), c[3])
+    return c[0] - c[2] * x - dphi(p, c[1], -x, c[3])
 
 
 @njit(cache=True)
-def phase_dfn(kind, law, p, x, c):
+def phase_dfn(kind, p, x, c):
     """Derivative of :func:`phase_fn` with respect to ``x``."""
     if kind == 0:
         theta = c[1] + x
-        return c[2] - law(c[3] / theta, p)[1] / theta
-    return -c[2] + law(c[3] * math.exp(x) / c[1], p)[1]
+        return c[2] - law_eval(c[3] / theta, p)[1] / theta
+    return -c[2] + law_eval(c[3] * math.exp(x) / c[1], p)[1]
 
 
 @njit(cache=True)
-def brentq(kind, law, p, c, xa, xb, fa, fb):
+def brentq(kind, p, c, xa, xb, fa, fb):
     """Brent's method (the algorithm of scipy's ``brentq``) on :func:`phase_fn` over a
     bracket with ``fa * fb <= 0``; returns the root to about machine precision."""
     xtol = 1e-300
@@ -248,7 +272,7 @@ def brentq(kind, law, p, c, xa, xb, fa, fb):
             xcur += delta
         else:
             xcur -= delta
-        fcur = phase_fn(kind, law, p, xcur, c)
+        fcur = phase_fn(kind, p, xcur, c)
     return xcur
 
 
@@ -256,7 +280,7 @@ def brentq(kind, law, p, c, xa, xb, fa, fb):
 # the stick and slip roots
 # --------------------------------------------------------------------------------------
 @njit(cache=True)
-def first_root(kind, law, p, c, x, x_max, k0V, w_neg, lipschitz):
+def first_root(kind, p, c, x, x_max, k0V, w_neg, lipschitz):
     r"""March from ``x`` (where the phase function has not yet crossed) to its first
     crossing, and refine it with :func:`brentq`.
 
@@ -274,18 +298,18 @@ def first_root(kind, law, p, c, x, x_max, k0V, w_neg, lipschitz):
     Returns ``(x, flag)``: FOUND, HORIZON (no crossing up to ``x_max``) or FAILED.
     """
     sgn = 1.0 if kind == 0 else -1.0
-    f = sgn * phase_fn(kind, law, p, x, c)
+    f = sgn * phase_fn(kind, p, x, c)
     x_start = x
     for _ in range(100000):
-        fp = sgn * phase_dfn(kind, law, p, x, c)
+        fp = sgn * phase_dfn(kind, p, x, c)
         if fp > 0.0:
             xn = x - f / fp
             if xn > x_max:
                 xn = x_max
             if xn > x:
-                fn = sgn * phase_fn(kind, law, p, xn, c)
+                fn = sgn * phase_fn(kind, p, xn, c)
                 if fn >= 0.0:
-                    return brentq(kind, law, p, c, x, xn, sgn * f, sgn * fn), FOUND
+                    return brentq(kind, p, c, x, xn, sgn * f, sgn * fn), FOUND
                 if xn == x_max:
                     return x_max, HORIZON
                 if xn > x + 1e-3 * (x - x_start):
@@ -311,9 +335,9 @@ def first_root(kind, law, p, c, x, x_max, k0V, w_neg, lipschitz):
         x_new = x + step
         if x_new >= x_max:
             x_new = x_max
-        f_new = sgn * phase_fn(kind, law, p, x_new, c)
+        f_new = sgn * phase_fn(kind, p, x_new, c)
         if f_new >= 0.0:
-            return brentq(kind, law, p, c, x, x_new, sgn * f, sgn * f_new), FOUND
+            return brentq(kind, p, c, x, x_new, sgn * f, sgn * f_new), FOUND
         if x_new == x_max:
             return x_max, HORIZON
         if x_new == x:
@@ -324,7 +348,7 @@ def first_root(kind, law, p, c, x, x_max, k0V, w_neg, lipschitz):
 
 
 @njit(cache=True)
-def stick_end(law, p, h0, theta0, k0V, Dc, t_max, w_neg):
+def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg):
     r"""First time :math:`t \in (0, t_{max}]` at which a stick started at
     :math:`(\sigma_0, \theta_0)` reaches the threshold, :math:`\sigma_0 + k_0 V t = \phi(\theta_0 + t)`
     (closed-form stick: :math:`\theta = \theta_0 + t`, :math:`\sigma = \sigma_0 + k_0 V t`).
@@ -344,13 +368,13 @@ def stick_end(law, p, h0, theta0, k0V, Dc, t_max, w_neg):
     t = 0.0
     if h0 >= 0.0:
         t = min(1e-7 * theta0, t_max)
-        if phase_fn(0, law, p, t, c) >= 0.0:
+        if phase_fn(0, p, t, c) >= 0.0:
             return 0.0, FOUND
-    return first_root(0, law, p, c, t, t_max, k0V, w_neg, 1.0)
+    return first_root(0, p, c, t, t_max, k0V, w_neg, 1.0)
 
 
 @njit(cache=True)
-def slip_end(law, p, g0, theta0, K, Dc, lipschitz, theta_floor):
+def slip_end(p, g0, theta0, K, Dc, lipschitz, theta_floor):
     r"""First root :math:`s > 0` of the slip function :math:`g(s)` of :func:`phase_fn`:
     the instantaneous slip :math:`\Delta x = D_c s` with :math:`\theta = \theta_0 e^{-s}` and
     :math:`\sigma = \sigma_0 - k_0 \Delta x` stops when :math:`\sigma = \phi(\theta)` again
@@ -377,23 +401,23 @@ def slip_end(law, p, g0, theta0, K, Dc, lipschitz, theta_floor):
         # on the threshold: the slip exists only if g rises just after s = 0
         found = False
         for trial in (1e-8, 1e-6, 1e-4):
-            if trial < s_max and phase_fn(1, law, p, trial, c) > 0.0:
+            if trial < s_max and phase_fn(1, p, trial, c) > 0.0:
                 s = trial
                 found = True
                 break
         if not found:
             return 0.0, NO_SLIP
-    s, flag = first_root(1, law, p, c, s, s_max, 0.0, 0.0, lipschitz)
+    s, flag = first_root(1, p, c, s, s_max, 0.0, 0.0, lipschitz)
     if flag == HORIZON:
-        g = phase_fn(1, law, p, s_max, c)
-        d = K - law(Dc / theta_floor, p)[1]
+        g = phase_fn(1, p, s_max, c)
+        d = K - law_eval(Dc / theta_floor, p)[1]
         if d > 0.0:
             return s_max + max(g, 0.0) / d, FLOOR
     return s, flag
 
 
 @njit(cache=True)
-def decide(law, p, theta, K, V, Dc):
+def decide(p, theta, K, V, Dc):
     r"""The phase that follows a point on the threshold :math:`\sigma = \phi(\theta)`.
 
     With :math:`N = KV - uW` and :math:`D = K - W`: stick if :math:`N < 0` (the stick flow
@@ -403,7 +427,7 @@ def decide(law, p, theta, K, V, Dc):
     the stick and slip functions a small step ahead.
     """
     u = Dc / theta
-    w = law(u, p)[1]
+    w = law_eval(u, p)[1]
     N = K * V - u * w
     D = K - w
     scale_n = K * V + u * abs(w) + 1e-300
@@ -416,7 +440,7 @@ def decide(law, p, theta, K, V, Dc):
         c[1] = theta
         c[2] = K * V / Dc
         c[3] = Dc
-        if phase_fn(0, law, p, 1e-5 * theta, c) < 0.0:
+        if phase_fn(0, p, 1e-5 * theta, c) < 0.0:
             return STICK
     if D > 1e-12 * scale_d:
         return SLIDE
@@ -426,7 +450,7 @@ def decide(law, p, theta, K, V, Dc):
     c[1] = theta
     c[2] = K
     c[3] = Dc
-    if phase_fn(1, law, p, 1e-5, c) > 0.0:
+    if phase_fn(1, p, 1e-5, c) > 0.0:
         return SLIP
     return SLIDE
 
@@ -435,7 +459,7 @@ def decide(law, p, theta, K, V, Dc):
 # the slide: CVODE right-hand side and events in the desingularised time tau
 # --------------------------------------------------------------------------------------
 @njit(cache=True)
-def slide_rhs(y, yp, law, p, c):
+def slide_rhs(y, yp, p, c):
     r"""Reduced slide ODE in the time :math:`\tau` with :math:`\mathrm{d}t = D_c D/(K v_s)\,\mathrm{d}\tau`.
 
     ``y = [z, t, I]`` with :math:`\theta = \theta_s e^{z}`, local time ``t`` and
@@ -445,7 +469,7 @@ def slide_rhs(y, yp, law, p, c):
     """
     K = c[0]
     u = c[4] * math.exp(-y[0])
-    mu, w = law(u, p)
+    mu, w = law_eval(u, p)
     dt = c[2] * (K - w) / (K * c[3])
     yp[0] = (u - c[1]) / c[3]
     yp[1] = dt
@@ -453,7 +477,7 @@ def slide_rhs(y, yp, law, p, c):
 
 
 @njit(cache=True)
-def slide_events(y, e, law, p, c):
+def slide_events(y, e, p, c):
     """Slide events: ``e[0]`` D (slide -> slip), ``e[1]`` N (v -> 0, slide -> stick),
     ``e[2]`` |ln(u/V)| - s_tol (steady), ``e[3]`` W (interior extremum of sigma),
     ``e[4]`` t - t_stop.  ``c[5:10] = [s_tol, t_stop, ln V, steady_on, extrema_on]``
@@ -461,7 +485,7 @@ def slide_events(y, e, law, p, c):
     K = c[0]
     V = c[1]
     u = c[4] * math.exp(-y[0])
-    w = law(u, p)[1]
+    w = law_eval(u, p)[1]
     scale_d = K + abs(w)
     e[0] = (K - w) / scale_d
     scale_n = K * V + u * abs(w)
@@ -484,62 +508,102 @@ def slide_events(y, e, law, p, c):
 # a > 0: the regular rate-and-state ODE
 # --------------------------------------------------------------------------------------
 @njit(cache=True)
-def rs_rhs(y, yp, law, p, c):
-    r"""Spring-slider with direct effect :math:`a > 0`:
-    :math:`\sigma = \mu_{ss}(u) + a\ln(v/u)`, :math:`u = D_c/\theta`.
+def rs_rhs(y, yp, p, c):
+    r"""Spring-slider with a direct effect :math:`a > 0`:
+    :math:`\sigma = \mu_{ss}(u) + a\ln(v/u)` with :math:`u = D_c/\theta`.
 
-    ``y = [ln v, q, x, I]`` with :math:`q = \ln(\theta/D_c) = -\ln u`,
-    ``c = [k0, V, Dc, a, state_law, ...]`` (``state_law`` 0 aging, Eq. 8; 1 Ruina slip).
-    Differentiating the friction law at :math:`\sigma = k_0(X_{lp} - x)` gives
-    :math:`a\,\mathrm{d}\ln v/\mathrm{d}t = k_0(V - v) - (W + a)\,\dot q`.
+    Differentiating the friction at :math:`\sigma = k_0(X(t) - x)` gives
+    :math:`a\,\mathrm{d}\ln v/\mathrm{d}t = k_0(V - v) - (W + a)\,\mathrm{d}\ln\theta/\mathrm{d}t`
+    with :math:`\mathrm{d}\ln\theta/\mathrm{d}t = (u - v)/D_c` (aging, Eq. 8) or
+    :math:`-(v/D_c)\ln(v/u)` (Ruina slip law).  The independent variable is the
+    dimensionless :math:`s` with :math:`\mathrm{d}s = (v_s + v)\,\mathrm{d}t/D_c`, which
+    follows time in slow phases and slip in fast ones, so that the nearly instantaneous
+    slips of small :math:`a` stay resolvable; with :math:`f = v_s/(v_s + v)` (computed
+    from :math:`\ln v` without overflow) every rate below is bounded.
+
+    ``y = [w, r, x, I, t]`` with :math:`w = \ln(v/v_s)`, :math:`r = \ln(v_s/u)` (both 0 in
+    steady sliding at :math:`V = v_s`, so that event functions near it are not differences
+    of large numbers) and :math:`I = \int (\sigma - \mu_{ref})\,\mathrm{d}t`;
+    ``c = [K, V, Dc, a, state_law, v_s, ...]`` (``state_law`` 0 aging, 1 slip).
     """
-    k0 = c[0]
+    K = c[0]
     V = c[1]
     Dc = c[2]
     a = c[3]
-    lv = y[0]
-    q = y[1]
-    v = math.exp(lv)
-    u = math.exp(-q)
-    mu, w = law(u, p)
-    if c[4] == 0.0:
-        qdot = (u - v) / Dc
+    vs = c[5]
+    w = y[0]
+    r = y[1]
+    if w > 0.0:
+        ew = math.exp(-w)
+        f = ew / (1.0 + ew)
     else:
-        qdot = -(v / Dc) * (lv + q)
-    yp[0] = (k0 * (V - v) - (w + a) * qdot) / a
-    yp[1] = qdot
-    yp[2] = v
-    yp[3] = mu + a * (lv + q)
+        f = 1.0 / (1.0 + math.exp(w))
+    g = 1.0 - f                      # v / (vs + v)
+    er = math.exp(-r)                # u / vs
+    mu, wk = law_eval(vs * er, p)
+    if c[4] == 0.0:
+        dr = er * f - g
+    else:
+        dr = -g * (w + r)
+    dt = Dc / vs * f
+    yp[0] = (K * ((V / vs) * f - g) - (wk + a) * dr) / a
+    yp[1] = dr
+    yp[2] = Dc * g
+    yp[3] = (mu + a * (w + r)) * dt
+    yp[4] = dt
 
 
 @njit(cache=True)
-def rs_events(y, e, law, p, c):
-    """Events of the a > 0 ODE: ``e[0]`` ln v - ln V (sigma extremum), ``e[1]`` distance to
-    the steady state minus s_tol, ``e[2]`` t - t_stop (``y[4]`` is not used: the time is
-    passed in ``c[9]`` by the caller).  ``c[5:9] = [ln V, q_ss, s_tol, steady_on]``."""
+def rs_events(y, e, p, c):
+    """Events of the a > 0 ODE: ``e[0]`` and ``e[1]`` ln(v/V) (sigma maximum when rising,
+    minimum when falling), ``e[2]`` distance to the steady state minus s_tol, ``e[3]``
+    t - t_stop.  ``c[6:11] = [ln(V/v_s), ln(v_s/V), s_tol, steady_on, t_stop]``."""
     if c[1] > 0.0:
-        e[0] = y[0] - c[5]
-        if c[8] > 0.0:
-            e[1] = abs(y[0] - c[5]) + abs(y[1] - c[6]) - c[7]
+        e[0] = y[0] - c[6]
+        e[1] = e[0]
+        if c[9] > 0.0:
+            e[2] = abs(y[0] - c[6]) + abs(y[1] - c[7]) - c[8]
         else:
-            e[1] = 1.0
+            e[2] = 1.0
     else:
         e[0] = 1.0
         e[1] = 1.0
+        e[2] = 1.0
+    e[3] = y[4] - c[10]
 
 
 # --------------------------------------------------------------------------------------
-# pure-Python twins
+# the same kernels around another law
 # --------------------------------------------------------------------------------------
-def python_twins() -> dict[str, types.FunctionType]:
-    """Pure-Python copies of every kernel of this module, calling each other (and not the
-    compiled versions), for laws that numba cannot compile and for consistency tests."""
+KERNEL_NAMES = ("law_eval", "phi_w", "dphi", "phase_fn", "phase_dfn", "brentq", "first_root",
+                "stick_end", "slip_end", "decide", "slide_rhs", "slide_events", "rs_rhs",
+                "rs_events")
+
+
+def kernel_namespace(law_eval_func=None, jit: bool = False) -> dict:
+    """A fresh set of the kernels of this module in which ``law_eval`` is replaced by
+    ``law_eval_func`` (default: keep the built-in dispatch).
+
+    With ``jit=False`` every kernel is plain Python (its source, calling the other
+    plain-Python kernels); with ``jit=True`` they are compiled with numba for this law
+    (not cached on disk: a user's law is a new function in every process).
+    """
     namespace: dict = dict(globals())
-    twins: dict[str, types.FunctionType] = {}
-    for name, obj in list(namespace.items()):
-        if isinstance(obj, numba.core.registry.CPUDispatcher):
-            func = obj.py_func
-            twins[name] = types.FunctionType(func.__code__, namespace, name, func.__defaults__,
-                                             func.__closure__)
-    namespace.update(twins)
-    return twins
+    plain: dict = {}
+    for name in KERNEL_NAMES:
+        func = globals()[name].py_func
+        plain[name] = types.FunctionType(func.__code__, namespace, name, func.__defaults__,
+                                         func.__closure__)
+    if law_eval_func is not None:
+        plain["law_eval"] = law_eval_func
+    else:
+        for name in ("hyperbolic_law", "viscoelastic_law", "log_law", "table_law"):
+            func = globals()[name].py_func
+            plain[name] = types.FunctionType(func.__code__, namespace, name)
+    namespace.update(plain)
+    if jit:
+        compiled = {name: (f if isinstance(f, numba.core.registry.CPUDispatcher) else njit(f))
+                    for name, f in plain.items()}
+        namespace.update(compiled)
+        return {name: namespace[name] for name in KERNEL_NAMES}
+    return {name: namespace[name] for name in KERNEL_NAMES}

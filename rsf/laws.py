@@ -7,8 +7,9 @@ Eq. (11), :math:`\mu(\theta) = \mu_{ss}(D_c/\theta)`.  Every law offers
 * ``mu_ss(v)`` and ``dmu_ss(v)`` (numpy, vectorised),
 * ``weakening(v)`` :math:`= W(v) = -v\,\mathrm{d}\mu_{ss}/\mathrm{d}v` (positive where the
   law is velocity weakening; the stability of steady sliding is decided by :math:`W`),
-* ``kernel`` — a numba-compiled ``(v, p) -> (mu_ss - mu_ref, W)`` and its parameter array
-  ``p``, used by the solver; ``mu_ref`` is a constant reference level (the large-velocity
+* ``kernel_params`` — the float array ``p`` (law code and parameters) that the solver's
+  numba kernels evaluate as ``law_eval(v, p) -> (mu_ss - mu_ref, W)``, and ``kernels()``,
+  the kernel set to use; ``mu_ref`` is a constant reference level (the large-velocity
   limit where it exists), subtracted so that frictions just above it keep full relative
   precision,
 * ``bind(k0)`` — a copy with the defaults that depend on the driving stiffness resolved.
@@ -97,18 +98,24 @@ class SteadyStateLaw:
 
     # -- solver interface ---------------------------------------------------------------
     @property
-    def kernel(self) -> tuple[Callable, np.ndarray]:
-        """``(law, p)``: the compiled ``law(v, p) -> (mu_ss - mu_ref, W)`` and its parameters."""
+    def kernel_params(self) -> np.ndarray:
+        """``p`` for ``_kernels.law_eval(v, p) -> (mu_ss - mu_ref, W)``: the law's code then
+        its parameters."""
         raise NotImplementedError
+
+    def kernels(self) -> dict[str, Callable]:
+        """The kernel set (name -> function) that evaluates this law: the module's cached
+        numba kernels for the built-in laws."""
+        return {name: getattr(_kernels, name) for name in _kernels.KERNEL_NAMES}
 
     @property
     def mu_ref(self) -> float:
-        """The constant that :attr:`kernel` subtracts from the friction."""
+        """The constant that the kernels subtract from the friction."""
         return 0.0
 
     @property
     def jitted(self) -> bool:
-        """Whether :attr:`kernel` is numba-compiled (else the solver runs pure Python)."""
+        """Whether the kernels are numba-compiled (else the solver runs pure Python)."""
         return True
 
     def weakening_bounds(self) -> tuple[float, float]:
@@ -183,11 +190,17 @@ class HyperbolicLaw(SteadyStateLaw):
 
     def dmu_ss(self, v):
         v = _as_velocity_array(v)
-        return -self.A / (v + self.B) ** 2
+        d = v + self.B
+        return -self.A / d / d
+
+    def weakening(self, v):
+        v = _as_velocity_array(v)
+        d = v + self.B
+        return self.A * (v / d) / d
 
     @property
-    def kernel(self):
-        return _kernels.hyperbolic_law, np.array([self.A, self.B])
+    def kernel_params(self):
+        return np.array([_kernels.KIND_HYPERBOLIC, self.A, self.B], dtype=float)
 
     @property
     def mu_ref(self) -> float:
@@ -263,8 +276,8 @@ class ViscoelasticLaw(SteadyStateLaw):
         c = self.zbar * self.k2
         with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
             y = c / (v * self.eta_u)
-            h = np.where(y < 1e-3, 0.5 - y / 12.0 + y ** 3 / 720.0,
-                         1.0 / y - 1.0 / np.expm1(np.minimum(y, 700.0)))
+            series = 0.5 - y / 12.0 + y ** 3 / 720.0 - y ** 5 / 30240.0 + y ** 7 / 1209600.0
+            h = np.where(y < 0.05, series, 1.0 / y - 1.0 / np.expm1(np.clip(y, 0.05, 700.0)))
         h = np.where(v == 0.0, 0.0, h)
         return self.offset - c * h
 
@@ -276,14 +289,15 @@ class ViscoelasticLaw(SteadyStateLaw):
             ym = np.minimum(y, 700.0)
             # d(mu)/dv = -c h'(y) dy/dv = c y h'(y) / v, with
             # y h'(y) = -1/y + y e^y/(e^y - 1)^2 = -1/y + y / (4 sinh^2(y/2))
-            yh = np.where(y < 1e-3, -y / 12.0 + y ** 3 / 240.0,
-                          -1.0 / ym + ym / (4.0 * np.sinh(0.5 * ym) ** 2))
+            series = -y / 12.0 + y ** 3 / 240.0 - y ** 5 / 6048.0 + y ** 7 / 172800.0
+            yc = np.maximum(ym, 0.05)
+            yh = np.where(y < 0.05, series, -1.0 / yc + yc / (4.0 * np.sinh(0.5 * yc) ** 2))
             out = c * yh / v
         return np.where((v == 0.0) | (y > 700.0), np.where(v == 0.0, 0.0, -c / (y * v)), out)
 
     @property
-    def kernel(self):
-        return _kernels.viscoelastic_law, np.array([self.zbar * self.k2, self.eta_u])
+    def kernel_params(self):
+        return np.array([_kernels.KIND_VISCOELASTIC, self.zbar * self.k2, self.eta_u], dtype=float)
 
     @property
     def mu_ref(self) -> float:
@@ -292,7 +306,7 @@ class ViscoelasticLaw(SteadyStateLaw):
 
     @cached_property
     def _w_max(self) -> float:
-        y = np.logspace(-4, 3, 4001)
+        y = np.logspace(-4, np.log10(300.0), 4001)
         w = 1.0 / y - y / (4.0 * np.sinh(0.5 * y) ** 2)
         return float(self.zbar * self.k2 * w.max())
 
@@ -352,8 +366,8 @@ class LogLaw(SteadyStateLaw):
         return np.full_like(v, self.b - self.a)
 
     @property
-    def kernel(self):
-        return _kernels.log_law, np.array([self.a - self.b, self.v0])
+    def kernel_params(self):
+        return np.array([_kernels.KIND_LOG, self.a - self.b, self.v0], dtype=float)
 
     @property
     def mu_ref(self) -> float:
@@ -457,7 +471,8 @@ class TabulatedLaw(SteadyStateLaw):
     @cached_property
     def _params(self) -> np.ndarray:
         n = self.V.size
-        return np.concatenate([[float(n)], np.log(self.V), self.mu - self.mu[-1], self._slopes])
+        return np.concatenate([[float(_kernels.KIND_TABLE), float(n)], np.log(self.V),
+                               self.mu - self.mu[-1], self._slopes])
 
     @property
     def mu_ref(self) -> float:
@@ -465,8 +480,8 @@ class TabulatedLaw(SteadyStateLaw):
         return float(self.mu[-1])
 
     @property
-    def kernel(self):
-        return _kernels.table_law, self._params
+    def kernel_params(self):
+        return self._params
 
     @cached_property
     def _bounds(self) -> tuple[float, float]:
@@ -537,29 +552,41 @@ class CallableLaw(SteadyStateLaw):
             if lo > hi:
                 raise ValueError(f"w_range must be (low, high) with low <= high, got {self.w_range!r}")
             object.__setattr__(self, "w_range", (lo, hi))
-        object.__setattr__(self, "_compiled", self._compile())
+        object.__setattr__(self, "_kernel_set", self._build_kernels())
 
-    def _compile(self):
+    def _build_kernels(self) -> tuple[dict, bool]:
+        mu, dmu = self.mu_ss_fn, self.dmu_ss_fn
         try:
             import numba
 
-            mu_j = numba.njit(self.mu_ss_fn)
-            dmu_j = numba.njit(self.dmu_ss_fn)
+            mu_j = numba.njit(mu)
+            dmu_j = numba.njit(dmu)
 
             @numba.njit
-            def law(v, p):
+            def law_eval(v, p):
                 return mu_j(v), -v * dmu_j(v)
 
-            law(1.0, np.zeros(1))
-            return law
+            law_eval(1.0, np.zeros(1))
+            return _kernels.kernel_namespace(law_eval, jit=True), True
         except Exception as exc:  # numba raises many error types when it cannot compile
             logger.info("numba cannot compile %s (%s); the solver will run pure Python",
                         self.label, type(exc).__name__)
-            return None
+
+        def law_eval_py(v, p):
+            return float(mu(v)), -v * float(dmu(v))
+
+        return _kernels.kernel_namespace(law_eval_py, jit=False), False
 
     @property
     def jitted(self) -> bool:
-        return self._compiled is not None  # type: ignore[attr-defined]
+        return self._kernel_set[1]  # type: ignore[attr-defined]
+
+    def kernels(self):
+        return self._kernel_set[0]  # type: ignore[attr-defined]
+
+    @property
+    def kernel_params(self):
+        return np.array([float(_kernels.KIND_USER)])
 
     def mu_ss(self, v):
         v = _as_velocity_array(v)
@@ -568,17 +595,6 @@ class CallableLaw(SteadyStateLaw):
     def dmu_ss(self, v):
         v = _as_velocity_array(v)
         return np.vectorize(lambda x: float(self.dmu_ss_fn(float(x))), otypes=[float])(v)
-
-    @property
-    def kernel(self):
-        if self._compiled is not None:  # type: ignore[attr-defined]
-            return self._compiled, np.zeros(1)  # type: ignore[attr-defined]
-        mu, dmu = self.mu_ss_fn, self.dmu_ss_fn
-
-        def law(v, p):
-            return float(mu(v)), -v * float(dmu(v))
-
-        return law, np.zeros(1)
 
     @cached_property
     def _bounds(self) -> tuple[float, float]:

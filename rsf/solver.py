@@ -31,7 +31,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from . import _kernels
-from ._sundials import integrate
+from ._sundials import OdeSolution, integrate
 from ._validation import positive
 from .params import InitialState, Protocol, SolverOptions, SpringSlider
 from .results import STATUS_MESSAGES, CycleResult, Event, Status, SweepResult, Trajectory
@@ -40,32 +40,18 @@ __all__ = ["simulate", "limit_cycle", "sweep"]
 
 logger = logging.getLogger(__name__)
 
-_TWINS: dict | None = None
-_THETA_FLOOR = 1e-250    # smallest theta resolved, in units of Dc (slips level off below)
+_THETA_FLOOR = 1e-250   # smallest theta resolved, in units of Dc (slips level off below)
 _ZERO_PHASES = 20       # consecutive zero-length phases before giving up
+_TAU_CHUNK = 1e4        # length of one CVODE run in the slide time tau (and in units of
+                        # the natural time scale for the a > 0 ODE)
 
 
 class _Kernels:
-    """The kernel set for one law: numba-compiled, or the pure-Python twins."""
+    """The kernel set for one law (see :meth:`rsf.laws.SteadyStateLaw.kernels`)."""
 
-    def __init__(self, jitted: bool) -> None:
-        global _TWINS
-        if jitted:
-            src = {name: getattr(_kernels, name) for name in
-                   ("stick_end", "slip_end", "decide", "slide_rhs", "slide_events", "rs_rhs",
-                    "rs_events", "phase_fn")}
-        else:
-            if _TWINS is None:
-                _TWINS = _kernels.python_twins()
-            src = _TWINS
-        self.stick_end = src["stick_end"]
-        self.slip_end = src["slip_end"]
-        self.decide = src["decide"]
-        self.slide_rhs = src["slide_rhs"]
-        self.slide_events = src["slide_events"]
-        self.rs_rhs = src["rs_rhs"]
-        self.rs_events = src["rs_events"]
-        self.phase_fn = src["phase_fn"]
+    def __init__(self, law) -> None:
+        for name, func in law.kernels().items():
+            setattr(self, name, func)
 
 
 class _Stop(Exception):
@@ -110,9 +96,10 @@ class _PhaseEngine:
         self.options = options
         self.record = record
         self.stop_at_steady = stop_at_steady
-        self.law_fn, self.p = model.law.kernel
+        self.p = model.law.kernel_params
         self.mu_ref = model.law.mu_ref
-        self.k = _Kernels(model.law.jitted)
+        self.k = _Kernels(model.law)
+        self.law_fn = self.k.law_eval
         self.k0 = model.k0
         self.Dc = model.Dc
         self.K = model.K
@@ -152,7 +139,7 @@ class _PhaseEngine:
             self.samples.add(self.t, self.x, self.mu_ref + self.sigma, self.theta, v)
 
     def decide(self) -> int:
-        return int(self.k.decide(self.law_fn, self.p, self.theta, self.K, self.velocity(), self.Dc))
+        return int(self.k.decide(self.p, self.theta, self.K, self.velocity(), self.Dc))
 
     def start(self, initial: InitialState) -> None:
         V0 = float(self.protocol.velocities[0])
@@ -212,7 +199,7 @@ class _PhaseEngine:
         h0 = self.sigma - phi0
         if abs(h0) <= 1e-14 * max(1.0, abs(phi0)):
             h0 = 0.0
-        dt, flag = self.k.stick_end(self.law_fn, self.p, h0, self.theta, self.k0 * V, self.Dc,
+        dt, flag = self.k.stick_end(self.p, h0, self.theta, self.k0 * V, self.Dc,
                                     horizon, self.w_neg)
         if flag == _kernels.FAILED:
             raise _Stop(Status.SOLVER_FAILED, f"stick-end search failed at t = {self.t:g}")
@@ -254,7 +241,7 @@ class _PhaseEngine:
         if abs(g0) <= 1e-14 * max(1.0, abs(phi0)):
             g0 = 0.0
         floor = _THETA_FLOOR * self.Dc
-        s, flag = self.k.slip_end(self.law_fn, self.p, g0, self.theta, self.K, self.Dc,
+        s, flag = self.k.slip_end(self.p, g0, self.theta, self.K, self.Dc,
                                   self.lipschitz, floor)
         if flag == _kernels.HORIZON:
             raise _Stop(Status.RUNAWAY, f"at t = {self.t:g}, theta = {self.theta:g}")
@@ -277,6 +264,35 @@ class _PhaseEngine:
         self.phase = nxt
         return self.emit({_kernels.STICK: "slip->stick", _kernels.SLIDE: "slip->slide",
                           _kernels.SLIP: "slip->slip"}[nxt])
+
+    def _integrate_chunks(self, rhs, events, atol) -> OdeSolution:
+        """CVODE over the slide in chunks of tau (CVODE ties its smallest step to the
+        output time, so an open-ended output time is not an option)."""
+        opts = self.options
+        y0 = np.zeros(3)
+        tau0 = 0.0
+        ts, ys, evs = [], [], []
+        nfev = 0
+        for _ in range(100000):
+            sol = integrate(rhs, y0, tau0, tau0 + _TAU_CHUNK, events=events,
+                            terminal=(True, True, True, False, True), direction=(-1, -1, -1, 0, 1),
+                            rtol=opts.rtol, atol=atol, method=opts.method,
+                            max_num_steps=opts.max_num_steps, save_steps=self.record)
+            nfev += sol.nfev
+            if not sol.success:
+                raise _Stop(Status.SOLVER_FAILED, f"CVODE in a slide at t = {self.t:g}: {sol.message}")
+            ts.append(sol.t if not ts else sol.t[1:])
+            ys.append(sol.y if not ys else sol.y[1:])
+            evs.extend(sol.events)
+            if sol.terminal_event is not None:
+                sol.t = np.concatenate(ts)
+                sol.y = np.concatenate(ys)
+                sol.events = evs
+                sol.nfev = nfev
+                return sol
+            tau0 = float(sol.t[-1])
+            y0 = sol.y[-1].copy()
+        raise _Stop(Status.SOLVER_FAILED, f"slide at t = {self.t:g} did not end")
 
     def _slide(self, t_end: float) -> Event:
         V = self.velocity()
@@ -301,20 +317,14 @@ class _PhaseEngine:
         k = self.k
 
         def rhs(tau, y, yp):
-            k.slide_rhs(y, yp, law, p, c)
+            k.slide_rhs(y, yp, p, c)
 
         def events(tau, y, e):
-            k.slide_events(y, e, law, p, c)
+            k.slide_events(y, e, p, c)
 
         t_scale = self.Dc / vs
         atol = np.array([opts.atol, opts.atol * t_scale, opts.atol * t_scale * max(1.0, abs(self.sigma))])
-        sol = integrate(rhs, np.zeros(3), 0.0, 1e30, events=events,
-                        terminal=(True, True, True, False, True), direction=(-1, -1, -1, 0, 1),
-                        rtol=opts.rtol, atol=atol, method=opts.method,
-                        max_num_steps=opts.max_num_steps, save_steps=self.record)
-        self.nfev += sol.nfev
-        if not sol.success or sol.terminal_event is None:
-            raise _Stop(Status.SOLVER_FAILED, f"CVODE in a slide at t = {self.t:g}: {sol.message}")
+        sol = self._integrate_chunks(rhs, events, atol)
         t0 = self.t
         x_lp0 = self.load_point(t0)
         if self.record:
@@ -362,7 +372,8 @@ class _PhaseEngine:
 # a > 0: the regular rate-and-state ODE
 # ======================================================================================
 class _SmoothEngine:
-    """CVODE (BDF) on ``y = [ln v, ln(theta/Dc), x, int sigma dt]`` for a > 0."""
+    """CVODE (BDF) on ``y = [ln v, ln(theta/Dc), x, int (sigma - mu_ref) dt, t]`` for a > 0,
+    in the slip-regularised variable s of :func:`rsf._kernels.rs_rhs`."""
 
     def __init__(self, model: SpringSlider, protocol: Protocol, options: SolverOptions,
                  record: bool, stop_at_steady: bool) -> None:
@@ -371,14 +382,24 @@ class _SmoothEngine:
         self.options = options
         self.record = record
         self.stop_at_steady = stop_at_steady
-        self.law_fn, self.p = model.law.kernel
+        self.p = model.law.kernel_params
         self.mu_ref = model.law.mu_ref
-        self.k = _Kernels(model.law.jitted)
+        self.k = _Kernels(model.law)
+        self.law_fn = self.k.law_eval
         self.samples = _Samples()
         self.events: list[Event] = []
-        self.t = 0.0
-        self.y = np.zeros(4)
+        self.y = np.zeros(5)
         self.nfev = 0
+        self.at_root = False       # the state sits on an event root (after a terminal event)
+
+    @property
+    def t(self) -> float:
+        return float(self.y[4])
+
+    @property
+    def integral(self) -> float:
+        """Running integral of the absolute sigma dt."""
+        return float(self.y[3]) + self.mu_ref * float(self.y[4])
 
     def sigma_of(self, y: np.ndarray) -> float:
         u = math.exp(-y[1])
@@ -387,10 +408,9 @@ class _SmoothEngine:
     def theta_of(self, y: np.ndarray) -> float:
         return self.model.Dc * math.exp(y[1])
 
-    def emit(self, kind: str, t: float | None = None, y: np.ndarray | None = None) -> Event:
-        t = self.t if t is None else t
+    def emit(self, kind: str, y: np.ndarray | None = None) -> Event:
         y = self.y if y is None else y
-        ev = Event(t, kind, self.sigma_of(y), self.theta_of(y), float(y[2]))
+        ev = Event(float(y[4]), kind, self.sigma_of(y), self.theta_of(y), float(y[2]))
         self.events.append(ev)
         return ev
 
@@ -410,78 +430,112 @@ class _SmoothEngine:
             lv = math.log(V0)
         else:
             lv = math.log(u) + (initial.sigma - self.mu_ref - float(self.law_fn(u, self.p)[0])) / m.a
-        self.y = np.array([lv, math.log(theta / m.Dc), 0.0, 0.0])
-        sigma = self.sigma_of(self.y)
-        self.y[2] = self.protocol.load_point(0.0) - sigma / m.k0
-        self.t = 0.0
+        self.y = np.array([lv, math.log(theta / m.Dc), 0.0, 0.0, 0.0])
+        self.y[2] = self.protocol.load_point(0.0) - self.sigma_of(self.y) / m.k0
+        self.at_root = True        # v = V is a root of the extremum events
         if self.record:
-            self._record(np.array([0.0]), self.y[None, :])
+            self._record(self.y[None, :])
         self.emit("start")
 
     def set_state(self, lv: float, q: float) -> None:
-        sigma_old = self.sigma_of(self.y)
-        self.y = np.array([lv, q, self.y[2], self.y[3]])
-        sigma = self.sigma_of(self.y)
-        self.y[2] += (sigma_old - sigma) / self.model.k0
+        """Restart at (ln v, q) (used by the cycle extrapolation); x follows the spring."""
+        self.y = np.array([lv, q, 0.0, self.y[3], self.y[4]])
+        self.y[2] = self.protocol.load_point(self.t) - self.sigma_of(self.y) / self.model.k0
+        self.at_root = True
         self.emit("restart")
 
-    def _record(self, t: np.ndarray, y: np.ndarray) -> None:
+    def _record(self, y: np.ndarray) -> None:
         m = self.model
         u = np.exp(-y[:, 1])
         mu = np.array([self.law_fn(ui, self.p)[0] for ui in u])
-        self.samples.add(t, y[:, 2], self.mu_ref + mu + m.a * (y[:, 0] + y[:, 1]), m.Dc * np.exp(y[:, 1]),
-                         np.exp(y[:, 0]))
+        with np.errstate(over="ignore"):
+            v = np.exp(y[:, 0])
+        self.samples.add(y[:, 4], y[:, 2], self.mu_ref + mu + m.a * (y[:, 0] + y[:, 1]),
+                         m.Dc * np.exp(y[:, 1]), v)
 
     def step(self, t_end: float, stop_on_min: bool) -> Event:
         m = self.model
         opts = self.options
-        V = self.protocol.velocity_at(self.t)
-        t_stop = min(self.protocol.segment_end(self.t), t_end)
+        t_now = self.t
+        V = self.protocol.velocity_at(t_now)
+        t_stop = min(self.protocol.segment_end(t_now), t_end)
         lnV = math.log(V) if V > 0.0 else 0.0
         q_ss = -lnV
         w_ss = float(self.law_fn(V, self.p)[1]) if V > 0.0 else 0.0
         steady_on = 1.0 if (self.stop_at_steady and V > 0.0 and m.K - w_ss > 0.0) else 0.0
         if steady_on and abs(self.y[0] - lnV) + abs(self.y[1] - q_ss) <= opts.cycle_rtol:
             return self.emit("steady")
-        c = np.array([m.k0, V, m.Dc, m.a, 0.0 if m.state_law == "aging" else 1.0, lnV, q_ss,
-                      opts.cycle_rtol, steady_on])
-        k, law, p = self.k, self.law_fn, self.p
+        vs = V if V > 0.0 else max(math.exp(-self.y[1]), 1e-300)
+        lvs = math.log(vs)
+        c = np.array([m.K, V, m.Dc, m.a, 0.0 if m.state_law == "aging" else 1.0, vs,
+                      lnV - lvs if V > 0.0 else 0.0, lvs - lnV if V > 0.0 else 0.0,
+                      opts.cycle_rtol, steady_on, t_stop if math.isfinite(t_stop) else 1e300])
+        k, p = self.k, self.p
 
-        def rhs(t, y, yp):
-            k.rs_rhs(y, yp, law, p, c)
+        def rhs(s, y, yp):
+            k.rs_rhs(y, yp, p, c)
 
-        def events(t, y, e):
-            k.rs_events(y, e, law, p, c)
-            e[2] = e[1]
-            e[1] = e[0]
+        def events(s, y, e):
+            k.rs_events(y, e, p, c)
 
-        t_scale = m.Dc / max(V, math.exp(-self.y[1]), math.exp(self.y[0]))
+        def to_local(y: np.ndarray) -> np.ndarray:      # [ln v, q, ...] -> [w, r, ...]
+            out = y.copy()
+            out[0] = y[0] - lvs
+            out[1] = y[1] + lvs
+            return out
+
+        def to_global(y: np.ndarray) -> np.ndarray:
+            out = np.array(y, dtype=float, copy=True)
+            out[..., 0] += lvs
+            out[..., 1] -= lvs
+            return out
+
+        t_scale = m.Dc / vs
         atol = np.array([opts.atol, opts.atol, opts.atol * m.Dc,
-                         opts.atol * t_scale * max(1.0, abs(self.sigma_of(self.y)))])
-        sol = integrate(rhs, self.y, self.t, t_stop if math.isfinite(t_stop) else 1e300,
-                        events=events, terminal=(False, stop_on_min, True), direction=(1, -1, -1),
-                        rtol=opts.rtol, atol=atol, method="BDF", max_num_steps=opts.max_num_steps,
-                        save_steps=self.record)
-        self.nfev += sol.nfev
-        if not sol.success:
-            raise _Stop(Status.SOLVER_FAILED, f"CVODE at t = {self.t:g}: {sol.message}")
-        if self.record:
-            self._record(sol.t[1:], sol.y[1:])
-        for (t_ev, y_ev, idx, _sign) in sol.events:
-            if idx == 0:
-                self.emit("sigma_max", t_ev, y_ev)
-            elif idx == 1 and not stop_on_min:
-                self.emit("sigma_min", t_ev, y_ev)
-        self.t = float(sol.t[-1])
-        self.y = sol.y[-1].copy()
+                         opts.atol * t_scale * max(1.0, abs(self.sigma_of(self.y) - self.mu_ref)),
+                         opts.atol * t_scale])
+        y_loc = to_local(self.y)
+        if self.at_root:
+            # step off an event root without events (CVODE rejects a root at the start)
+            sol = integrate(rhs, y_loc, 0.0, 1e-6, rtol=opts.rtol, atol=atol, method="BDF",
+                            max_num_steps=opts.max_num_steps)
+            if not sol.success:
+                raise _Stop(Status.SOLVER_FAILED, f"CVODE at t = {self.t:g}: {sol.message}")
+            y_loc = sol.y[-1].copy()
+            self.at_root = False
+        s0 = 0.0
+        for _ in range(100000):
+            sol = integrate(rhs, y_loc, s0, s0 + _TAU_CHUNK, events=events,
+                            terminal=(False, stop_on_min, True, True), direction=(1, -1, -1, 1),
+                            rtol=opts.rtol, atol=atol, method="BDF",
+                            max_num_steps=opts.max_num_steps, save_steps=self.record)
+            self.nfev += sol.nfev
+            if not sol.success:
+                raise _Stop(Status.SOLVER_FAILED, f"CVODE at t = {self.t:g}: {sol.message}")
+            if self.record:
+                self._record(to_global(sol.y[1:]))
+            for (_s, y_ev, idx, _sign) in sol.events:
+                if idx == 0:
+                    self.emit("sigma_max", to_global(y_ev))
+                elif idx == 1 and not stop_on_min:
+                    self.emit("sigma_min", to_global(y_ev))
+            s0 = float(sol.t[-1])
+            y_loc = sol.y[-1].copy()
+            self.y = to_global(y_loc)
+            if sol.terminal_event is not None:
+                break
+        else:
+            raise _Stop(Status.SOLVER_FAILED, f"no progress at t = {self.t:g}")
         if sol.terminal_event == 1:
+            self.at_root = True
             return self.emit("sigma_min")
         if sol.terminal_event == 2:
             return self.emit("steady")
-        if self.t >= t_end * (1.0 - 1e-15):
-            self.t = t_end
+        # terminal_event == 3: end of the window or a change of driving
+        self.y[4] = t_stop
+        self.at_root = True
+        if t_stop >= t_end:
             return self.emit("end")
-        self.t = t_stop
         return self.emit("drive")
 
 
@@ -629,8 +683,6 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
     anchor_sigma = math.nan
 
     def integral_now() -> float:
-        if smooth:
-            return float(engine.y[3]) + engine.mu_ref * engine.t
         return engine.integral
 
     def section_now() -> float:
