@@ -333,8 +333,10 @@ class _PhaseEngine:
             u_arr = self.Dc / theta_arr
             mu_arr = np.array([law(u, p)[0] for u in u_arr])
             w_arr = np.array([law(u, p)[1] for u in u_arr])
+            d_arr = self.K - w_arr
             with np.errstate(divide="ignore", invalid="ignore"):
-                v_arr = (self.K * V - u_arr * w_arr) / (self.K - w_arr)
+                v_arr = (self.K * V - u_arr * w_arr) / d_arr
+            v_arr[d_arr <= 0.0] = np.inf     # the slide ends where v diverges (D = 0)
             t_arr = t0 + ys[:, 1]
             self.samples.add(t_arr, x_lp0 + V * ys[:, 1] - (self.mu_ref + mu_arr) / self.k0,
                              self.mu_ref + mu_arr, theta_arr, v_arr)
