@@ -348,7 +348,7 @@ def first_root(kind, p, c, x, x_max, k0V, w_neg, lipschitz):
 
 
 @njit(cache=True)
-def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg):
+def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg, concave_sup):
     r"""First time :math:`t \in (0, t_{max}]` at which a stick started at
     :math:`(\sigma_0, \theta_0)` reaches the threshold, :math:`\sigma_0 + k_0 V t = \phi(\theta_0 + t)`
     (closed-form stick: :math:`\theta = \theta_0 + t`, :math:`\sigma = \sigma_0 + k_0 V t`).
@@ -356,6 +356,13 @@ def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg):
     ``h0 = sigma0 - phi(theta0) <= 0``; ``h0 = 0`` means a start on the threshold (after a
     slip, or where a slide stops), in which case the stick first steps off by
     1e-7 theta0.  ``w_neg`` bounds :math:`\max(0, -W)` (0 for velocity-weakening laws).
+
+    ``concave_sup`` is NaN unless :math:`\phi` is concave in :math:`\theta` (the law says
+    so), in which case it is :math:`\sup\phi` (relative, inf if unbounded): then
+    :math:`h(t)` is convex, a negative value anywhere certifies that no root lies before
+    it, and the root is bracketed directly (between the first negative point and the time
+    at which :math:`\sigma` passes :math:`\sup\phi`, or by tenfold steps) instead of
+    marched to.
 
     Returns ``(t, flag)`` with ``flag`` one of FOUND, HORIZON (no end before ``t_max``),
     FAILED.
@@ -366,10 +373,32 @@ def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg):
     c[2] = k0V
     c[3] = Dc
     t = 0.0
+    h = h0
     if h0 >= 0.0:
         t = min(1e-7 * theta0, t_max)
-        if phase_fn(0, p, t, c) >= 0.0:
+        h = phase_fn(0, p, t, c)
+        if h >= 0.0:
             return 0.0, FOUND
+    if concave_sup == concave_sup and k0V > 0.0:
+        # h convex: every negative point is certified root-free before it
+        phi0 = law_eval(Dc / theta0, p)[0]
+        if concave_sup < math.inf:
+            t_hi = (concave_sup - (h0 + phi0)) / k0V
+            t_hi = max(t_hi * (1.0 + 1e-12), t * 2.0)
+        else:
+            t_hi = max(10.0 * t, theta0)
+        for _ in range(2000):
+            if t_hi >= t_max:
+                t_hi = t_max
+            h_hi = phase_fn(0, p, t_hi, c)
+            if h_hi >= 0.0:
+                return brentq(0, p, c, t, t_hi, h, h_hi), FOUND
+            if t_hi == t_max:
+                return t_max, HORIZON
+            t = t_hi
+            h = h_hi
+            t_hi = 10.0 * t_hi + theta0
+        return t, FAILED
     return first_root(0, p, c, t, t_max, k0V, w_neg, 1.0)
 
 
@@ -453,6 +482,45 @@ def decide(p, theta, K, V, Dc):
     if phase_fn(1, p, 1e-5, c) > 0.0:
         return SLIP
     return SLIDE
+
+
+@njit(cache=True)
+def slide_converges(p, u_s, V, K):
+    r"""Whether a slide started at state velocity ``u_s`` certainly converges to steady
+    sliding at ``V`` without an event.
+
+    In a slide :math:`u` moves monotonically from :math:`u_s` towards :math:`V` (the reduced
+    ODE is one-dimensional), so it converges iff neither :math:`D = K - W` nor
+    :math:`N = KV - uW` vanishes on the way.  Both are sampled on a grid in :math:`\ln u`
+    (spacing at most 0.01); the answer is True only if every sample is positive with a
+    margin of four times the largest change between neighbouring samples, so that no root
+    can hide between them.  False means "integrate and see".
+    """
+    span = math.log(V / u_s)
+    n = int(abs(span) / 0.01) + 8
+    if n > 4000:
+        return False
+    d_min = math.inf
+    n_min = math.inf
+    dd = 0.0
+    dn = 0.0
+    d_prev = 0.0
+    n_prev = 0.0
+    for i in range(n + 1):
+        u = u_s * math.exp(span * i / n)
+        w = law_eval(u, p)[1]
+        d = K - w
+        nn = K * V - u * w
+        if d <= 0.0 or nn <= 0.0:
+            return False
+        if i > 0:
+            dd = max(dd, abs(d - d_prev))
+            dn = max(dn, abs(nn - n_prev))
+        d_min = min(d_min, d)
+        n_min = min(n_min, nn)
+        d_prev = d
+        n_prev = nn
+    return d_min > 4.0 * dd and n_min > 4.0 * dn
 
 
 # --------------------------------------------------------------------------------------
@@ -576,8 +644,8 @@ def rs_events(y, e, p, c):
 # the same kernels around another law
 # --------------------------------------------------------------------------------------
 KERNEL_NAMES = ("law_eval", "phi_w", "dphi", "phase_fn", "phase_dfn", "brentq", "first_root",
-                "stick_end", "slip_end", "decide", "slide_rhs", "slide_events", "rs_rhs",
-                "rs_events")
+                "stick_end", "slip_end", "decide", "slide_converges", "slide_rhs",
+                "slide_events", "rs_rhs", "rs_events")
 
 
 def kernel_namespace(law_eval_func=None, jit: bool = False) -> dict:

@@ -118,6 +118,14 @@ class SteadyStateLaw:
         """Whether the kernels are numba-compiled (else the solver runs pure Python)."""
         return True
 
+    @property
+    def concave_sup(self) -> float:
+        r"""NaN unless :math:`\phi(\theta) = \mu_{ss}(D_c/\theta)` is concave in
+        :math:`\theta` (equivalently :math:`v W(v)` non-decreasing); then
+        :math:`\sup_v \mu_{ss} - \mu_{ref}` (inf if unbounded).  Lets the stick search
+        bracket its root directly."""
+        return math.nan
+
     def weakening_bounds(self) -> tuple[float, float]:
         r"""Lower and upper bounds of :math:`W(v)` over :math:`v > 0` (used only to size
         safe steps of the root searches)."""
@@ -209,6 +217,11 @@ class HyperbolicLaw(SteadyStateLaw):
 
     def weakening_bounds(self):
         return 0.0, self.A / (4.0 * self.B)
+
+    @property
+    def concave_sup(self) -> float:
+        # v W = A v^2 / (v + B)^2 increases; sup mu_ss - mu_inf = A / B at v = 0
+        return self.A / self.B
 
     def describe(self):
         return {"law": self.name, "A": self.A, "B": self.B, "mu_inf": self.mu_inf}
@@ -313,6 +326,12 @@ class ViscoelasticLaw(SteadyStateLaw):
     def weakening_bounds(self):
         return 0.0, self._w_max
 
+    @property
+    def concave_sup(self) -> float:
+        # v W(v) = (zbar k2)^2 / eta_u * F(y), F(y) = (1/y)(1/y - y / (4 sinh^2(y/2))) decreases
+        # in y = zbar k2 / (v eta_u) (checked in the tests); sup = mu_ss(0) - mu_ss(inf)
+        return 0.5 * self.zbar * self.k2
+
     def describe(self):
         return {"law": self.name, "f_th": self.f_th, "zbar": self.zbar, "k1": self.k1,
                 "k2": self.k2, "eta_u": self.eta_u}
@@ -375,6 +394,11 @@ class LogLaw(SteadyStateLaw):
 
     def weakening_bounds(self):
         return self.b - self.a, self.b - self.a
+
+    @property
+    def concave_sup(self) -> float:
+        # phi = mu0 + (b - a) ln(theta v0 / Dc): concave iff b >= a; unbounded above
+        return math.inf if self.b >= self.a else math.nan
 
     def describe(self):
         return {"law": self.name, "mu0": self.mu0, "a": self.a, "b": self.b, "v0": self.v0}

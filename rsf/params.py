@@ -158,16 +158,22 @@ class Protocol:
 
     def velocity_at(self, t: float) -> float:
         """The load-point velocity at time ``t`` (right-continuous)."""
+        if self.times.size == 1:
+            return float(self.velocities[0])
         i = int(np.searchsorted(self.times, t, side="right")) - 1
         return float(self.velocities[max(i, 0)])
 
     def segment_end(self, t: float) -> float:
         """The next change of velocity strictly after ``t`` (inf if none)."""
+        if self.times.size == 1:
+            return math.inf
         i = int(np.searchsorted(self.times, t, side="right"))
         return float(self.times[i]) if i < self.times.size else math.inf
 
     def load_point(self, t: float) -> float:
         r"""Load-point displacement :math:`X(t) = \int_0^t V\,\mathrm{d}t'`."""
+        if self.times.size == 1:
+            return float(self.velocities[0]) * t
         i = int(np.searchsorted(self.times, t, side="right")) - 1
         i = max(i, 0)
         dt = np.diff(self.times[: i + 1])

@@ -107,6 +107,7 @@ class _PhaseEngine:
         self.w_neg = max(0.0, -w_lo)
         self.lipschitz = self.K + max(abs(w_lo), abs(w_hi)) + 1e-300
         self.extrema_on = 1.0 if (w_lo < 0.0 < w_hi) else 0.0
+        self.concave_sup = model.law.concave_sup
         self.samples = _Samples()
         self.events: list[Event] = []
         self.t = 0.0
@@ -200,7 +201,7 @@ class _PhaseEngine:
         if abs(h0) <= 1e-14 * max(1.0, abs(phi0)):
             h0 = 0.0
         dt, flag = self.k.stick_end(self.p, h0, self.theta, self.k0 * V, self.Dc,
-                                    horizon, self.w_neg)
+                                    horizon, self.w_neg, self.concave_sup)
         if flag == _kernels.FAILED:
             raise _Stop(Status.SOLVER_FAILED, f"stick-end search failed at t = {self.t:g}")
         sigma_new = self.sigma + self.k0 * V * dt
@@ -309,7 +310,9 @@ class _PhaseEngine:
             w_ss = float(law(V, p)[1])
             if self.stop_at_steady and self.K - w_ss > 0.0:
                 steady_on = 1.0
-                if abs(math.log(u_s) - lnV) <= opts.cycle_rtol:
+                if abs(math.log(u_s) - lnV) <= opts.cycle_rtol or (
+                        t_stop == math.inf and self.k.slide_converges(self.p, u_s, V, self.K)):
+                    # already steady, or certain to converge to it with no switch on the way
                     return self.emit("steady")
         c = np.array([self.K, V, self.Dc, vs, u_s, opts.cycle_rtol,
                       t_stop - self.t if math.isfinite(t_stop) else 1e300, lnV, steady_on,

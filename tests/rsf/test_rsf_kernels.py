@@ -25,9 +25,10 @@ def test_compiled_kernels_match_plain_python(k0, V):
     lip = m.K + hi
     for theta in (m.Dc / V * 1.3, m.Dc / V * 0.7, 1e-3, 10.0):
         h0 = -0.01
-        a = K.stick_end(p, h0, theta, m.k0 * V, m.Dc, 1e9, 0.0)
-        b = PLAIN["stick_end"](p, h0, theta, m.k0 * V, m.Dc, 1e9, 0.0)
-        assert a[1] == b[1] and a[0] == pytest.approx(b[0], rel=1e-13)
+        for sup in (math.nan, m.law.concave_sup):
+            a = K.stick_end(p, h0, theta, m.k0 * V, m.Dc, 1e9, 0.0, sup)
+            b = PLAIN["stick_end"](p, h0, theta, m.k0 * V, m.Dc, 1e9, 0.0, sup)
+            assert a[1] == b[1] and a[0] == pytest.approx(b[0], rel=1e-13)
         a = K.slip_end(p, 0.02, theta, m.K, m.Dc, lip, 1e-250 * m.Dc)
         b = PLAIN["slip_end"](p, 0.02, theta, m.K, m.Dc, lip, 1e-250 * m.Dc)
         assert a[1] == b[1] and a[0] == pytest.approx(b[0], rel=1e-13)
@@ -55,8 +56,11 @@ def _phi(m, theta):
 def test_stick_end_is_the_first_crossing(k0, V, theta0):
     m, p = _model(k0)
     sigma0 = _phi(m, theta0) - 1e-3
-    t, flag = K.stick_end(p, sigma0 - _phi(m, theta0), theta0, m.k0 * V, m.Dc, 1e12, 0.0)
-    assert flag == K.FOUND
+    t, flag = K.stick_end(p, sigma0 - _phi(m, theta0), theta0, m.k0 * V, m.Dc, 1e12, 0.0, math.nan)
+    t2, flag2 = K.stick_end(p, sigma0 - _phi(m, theta0), theta0, m.k0 * V, m.Dc, 1e12, 0.0,
+                            m.law.concave_sup)
+    assert flag == flag2 == K.FOUND
+    assert t2 == pytest.approx(t, rel=1e-12)     # the march and the convex bracket agree
     h = lambda tt: sigma0 + m.k0 * V * tt - _phi(m, theta0 + tt)  # noqa: E731 (numpy side)
     assert abs(h(t)) < 1e-13
     grid = np.concatenate([np.geomspace(1e-12 * max(t, 1e-300), t, 2000)[:-1], t * np.linspace(0, 1, 2000)[1:-1]])

@@ -156,3 +156,15 @@ def test_unbound_law_asks_for_k0():
         rsf.HyperbolicLaw().mu_ss(1.0)
     assert rsf.SpringSlider(k0=0.2).law.mu_inf == pytest.approx(rsf.paper_mu_inf(0.2))
     assert math.isclose(rsf.paper_mu_inf(0.0), 0.95)
+
+
+@pytest.mark.parametrize("law", LAWS, ids=lambda law: law.name)
+def test_concavity_flag_is_true(law):
+    # concave_sup claims phi(theta) concave, i.e. v W(v) non-decreasing, and bounds the excess
+    if math.isnan(law.concave_sup):
+        return
+    v = np.geomspace(1e-10, 1e10, 20001)
+    vw = v * law.weakening(v)
+    assert np.all(np.diff(vw) >= -1e-12 * np.abs(vw).max())
+    excess = law.mu_ss(v) - law.mu_ref
+    assert excess.max() <= law.concave_sup + 1e-15

@@ -33,9 +33,19 @@ def test_steady_run_stops_as_soon_as_steady():
     assert r.status == rsf.Status.STEADY and r.converged and r.regime == "steady"
     assert r.n_cycles == 0 and math.isnan(r.period)
     assert r.sigma_max == r.sigma_min == r.sigma_mean == pytest.approx(model.sigma_steady(20.0))
-    assert r.events[-1].kind == "steady"
-    # the state at the stop is within cycle_rtol of steady sliding
-    assert abs(math.log(model.Dc / r.events[-1].theta / 20.0)) <= 1e-8 * (1 + 1e-6)
+    stop = r.events[-1]
+    assert stop.kind == "steady"
+    # the run stopped where the outcome is certain: integrating on from that state gives a
+    # single slide with no switch, converging to steady sliding
+    tr = rsf.simulate(model, 20.0, t_end=stop.t + 50.0 * model.Dc / 20.0 * 100,
+                      initial=rsf.InitialState(theta=stop.theta, sigma=stop.sigma))
+    assert [e.kind for e in tr.events] == ["start", "end"]
+    assert tr.sigma[-1] == pytest.approx(model.sigma_steady(20.0), abs=1e-12)
+    # and without the certificate (a switch close by) CVODE's steady event ends the run
+    # within cycle_rtol of the steady state
+    tr2 = rsf.simulate(model, 20.0, t_end=1e3, stop_at_steady=True)
+    assert tr2.status == rsf.Status.STEADY
+    assert abs(math.log(model.Dc / tr2.events[-1].theta / 20.0)) <= 1e-8 * (1 + 1e-6)
 
 
 @pytest.mark.parametrize("k0, V", [(0.3, 0.04), (0.3, 0.15), (0.01, 0.001), (0.01, 5.0)])
