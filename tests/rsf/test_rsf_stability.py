@@ -98,3 +98,16 @@ def test_time_series_invariance():
     np.testing.assert_allclose(eb.t * 10.0, ea.t, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(eb.sigma, ea.sigma, atol=1e-10)
     np.testing.assert_allclose(eb.theta * 10.0, ea.theta, rtol=1e-8)
+
+
+@pytest.mark.parametrize("k0", [0.3, 0.01])
+def test_below_the_lower_root_every_start_ends_steady(k0):
+    # no coexisting stick-slip cycle below V_lower: stuck, over-stressed and on-threshold
+    # starts over twelve decades of theta all end in steady sliding
+    model = rsf.SpringSlider(k0=k0)
+    V = rsf.critical_velocity(model).V_lower * 0.9
+    for theta in np.geomspace(1e-6, 1e6, 13) * model.Dc / V:
+        phi = float(model.law.mu_ss(model.Dc / theta))
+        for offset in (-0.05, 0.0, 0.01):
+            r = rsf.limit_cycle(model, V, initial=rsf.InitialState(theta=theta, sigma=phi + offset))
+            assert r.regime == "steady" and r.converged, (theta, offset, r.message)
