@@ -16,7 +16,6 @@ from __future__ import annotations
 import math
 import time
 
-import numpy as np
 from scipy.integrate import solve_ivp
 
 A, B, DC = 0.007, 0.078, 0.06

@@ -13,7 +13,6 @@ total, to save time.)
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 import time
