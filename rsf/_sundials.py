@@ -1,0 +1,95 @@
+"""The one place that knows scikit-sundae's CVODE conventions.
+
+scikit-sundae differs from ``scipy.integrate.solve_ivp``: one ``eventsfn(t, y, events)``
+fills an array, ``num_events`` is required, ``eventsfn.terminal`` and
+``eventsfn.direction`` are lists (``terminal`` defaults to True), ``y`` is shaped
+``(n_times, n_vars)``, and ``max_num_steps`` counts steps per output interval.  Everything
+else in :mod:`rsf` calls :func:`integrate` and gets an :class:`OdeSolution`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+import sksundae as sun
+
+__all__ = ["OdeSolution", "integrate"]
+
+
+@dataclass
+class OdeSolution:
+    """Outcome of one CVODE run.
+
+    ``t`` and ``y`` (shape ``(n_times, n_vars)``) are the saved points (every internal step
+    if ``save_steps``, otherwise only the end point); ``events`` lists every event as
+    ``(t, y, index, direction)``; ``terminal_event`` is the index of the event that stopped
+    the run, or None.
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    events: list[tuple[float, np.ndarray, int, int]]
+    terminal_event: int | None
+    status: int
+    message: str
+    success: bool
+    nfev: int
+
+
+def integrate(rhs: Callable[[float, np.ndarray, np.ndarray], None], y0: np.ndarray, t0: float,
+              t1: float, *, events: Callable[[float, np.ndarray, np.ndarray], None] | None = None,
+              terminal: Sequence[bool] = (), direction: Sequence[int] = (), rtol: float = 1e-10,
+              atol: float | np.ndarray = 1e-12, method: str = "Adams",
+              max_num_steps: int = 1_000_000, save_steps: bool = False,
+              jac: Callable | None = None) -> OdeSolution:
+    """Integrate ``y' = rhs(t, y)`` from ``t0`` to ``t1`` with CVODE, stopping at the first
+    terminal event.
+
+    ``rhs(t, y, yp)`` fills ``yp``; ``events(t, y, e)`` fills ``e`` (length
+    ``len(terminal)``).  ``jac(t, y, yp, J)`` optionally fills the dense Jacobian.
+    """
+    options: dict = dict(rtol=rtol, atol=atol, method=method, max_num_steps=int(max_num_steps))
+    n_events = len(terminal)
+    if events is not None:
+        if len(direction) != n_events or n_events == 0:
+            raise ValueError("terminal and direction must list one entry per event")
+
+        def eventsfn(t, y, e):
+            events(t, y, e)
+
+        eventsfn.terminal = [bool(x) for x in terminal]
+        eventsfn.direction = [int(x) for x in direction]
+        options.update(eventsfn=eventsfn, num_events=n_events)
+    if jac is not None:
+        options["jacfn"] = jac
+    solver = sun.cvode.CVODE(rhs, **options)
+    y0 = np.ascontiguousarray(y0, dtype=float)
+    if save_steps:  # two points: scikit-sundae saves every internal step
+        tspan = np.array([t0, t1], dtype=float)
+    else:  # more than two: 'normal' mode, output only at tspan (cheaper per step)
+        tspan = np.array([t0, t0 + 0.5 * (t1 - t0), t1], dtype=float)
+    sol = solver.solve(tspan, y0)
+    t = np.asarray(sol.t, dtype=float)
+    y = np.asarray(sol.y, dtype=float).reshape(t.size, y0.size)
+    found: list[tuple[float, np.ndarray, int, int]] = []
+    terminal_event = None
+    if sol.i_events is not None:
+        i_ev = np.asarray(sol.i_events).reshape(-1, n_events)
+        t_ev = np.asarray(sol.t_events, dtype=float).ravel()
+        y_ev = np.asarray(sol.y_events, dtype=float).reshape(-1, y0.size)
+        for k in range(t_ev.size):
+            for idx in np.flatnonzero(i_ev[k]):
+                found.append((float(t_ev[k]), y_ev[k].copy(), int(idx), int(np.sign(i_ev[k, idx]))))
+        stopped_at_event = t.size > 0 and t_ev.size > 0 and t_ev[-1] == t[-1] and t[-1] != t1
+        if stopped_at_event:
+            for idx in np.flatnonzero(i_ev[-1]):
+                if terminal[idx]:
+                    terminal_event = int(idx)
+                    break
+    if not save_steps:
+        t = t[[0, -1]]
+        y = y[[0, -1]]
+    return OdeSolution(t=t, y=y, events=found, terminal_event=terminal_event,
+                       status=int(sol.status), message=str(sol.message), success=bool(sol.success),
+                       nfev=int(sol.nfev))

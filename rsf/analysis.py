@@ -1,0 +1,238 @@
+r"""Linear stability of steady sliding, and the scaling of the stick-slip amplitude near the
+bifurcation.
+
+Stability (``docs/rsf.md`` has the derivation).  Linearising the spring-slider about
+steady sliding at :math:`V` (:math:`\theta = D_c/V`) gives, for the aging law (Eq. 8),
+any direct effect :math:`a \ge 0` and the slip law alike, a trace proportional to
+:math:`W(V) - k_0 D_c` with :math:`W(V) = -V\,\mathrm{d}\mu_{ss}/\mathrm{d}V`: steady sliding
+is unstable where
+
+.. math:: k_0 D_c < -V \frac{\mathrm{d}\mu_{ss}}{\mathrm{d}V}.
+
+For Eq. (10), :math:`W(V) = AV/(V+B)^2` and the boundary :math:`k_0 D_c (V+B)^2 = AV` is the
+quadratic :math:`K V^2 + (2KB - A)V + KB^2 = 0` (:math:`K = k_0 D_c`) with roots
+
+.. math:: V_\pm = \frac{A - 2KB \pm \sqrt{A(A - 4KB)}}{2K}, \qquad V_+ V_- = B^2 .
+
+Real roots need :math:`K \le A/(4B)`.  :math:`V_+ = V^c` is the critical velocity of the
+paper: steady sliding is stable above it.  :math:`V_-` is the lower end of the unstable
+band: below it steady sliding is linearly stable again.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import brentq
+from scipy.stats import linregress
+
+from ._validation import positive
+from .laws import HyperbolicLaw, LogLaw, SteadyStateLaw
+from .params import SolverOptions, SpringSlider
+
+__all__ = ["CriticalVelocity", "critical_velocity", "HopfFit", "hopf_scaling", "fit_power_law"]
+
+
+@dataclass(frozen=True)
+class CriticalVelocity:
+    """Result of :func:`critical_velocity`.
+
+    Attributes
+    ----------
+    k0, Dc : float
+    Vc : float
+        The critical velocity: the largest V at which steady sliding turns unstable as V
+        decreases (``inf`` if it is unstable at all large V, ``nan`` if it is stable at every
+        V).
+    V_lower : float
+        Lower end of the unstable band containing Vc (0 if the band reaches V -> 0, nan if
+        there is no band).
+    roots : tuple of float
+        Every V > 0 with k0 Dc = W(V), ascending.
+    unstable : tuple of (float, float)
+        The intervals of V where steady sliding is linearly unstable.
+    method : str
+        'quadratic' (closed form for Eq. 10) or 'scan' (roots bracketed on a log grid).
+    """
+
+    k0: float
+    Dc: float
+    Vc: float
+    V_lower: float
+    roots: tuple[float, ...] = ()
+    unstable: tuple[tuple[float, float], ...] = ()
+    method: str = "scan"
+    params: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def K(self) -> float:
+        return self.k0 * self.Dc
+
+    def is_stable(self, V: float) -> bool:
+        """Whether steady sliding at V is linearly stable."""
+        return not any(lo < V < hi for lo, hi in self.unstable)
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row: k0, Dc, Vc, V_lower, method."""
+        return pd.DataFrame([{"k0": self.k0, "Dc": self.Dc, "Vc": self.Vc,
+                              "V_lower": self.V_lower, "method": self.method}])
+
+
+def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: float = 0.06, *,
+                      v_min: float = 1e-12, v_max: float = 1e12) -> CriticalVelocity:
+    r"""Where steady sliding loses stability: the roots of :math:`k_0 D_c = W(V)`.
+
+    Parameters
+    ----------
+    law : SteadyStateLaw, optional
+        Default: the paper's Eq. (10).  (Also accepts a :class:`~rsf.params.SpringSlider`
+        as first argument, whose law, k0 and Dc are then used.)
+    k0, Dc : float
+        Driving stiffness and critical slip distance, > 0.
+    v_min, v_max : float
+        Range scanned for roots of a general law (ignored for the closed forms).
+
+    Returns
+    -------
+    CriticalVelocity
+    """
+    if isinstance(law, SpringSlider):
+        model = law
+        law, k0, Dc = model.law, model.k0, model.Dc
+    if law is None:
+        law = HyperbolicLaw()
+    if not isinstance(law, SteadyStateLaw):
+        raise ValueError(f"law must be a SteadyStateLaw, got {law!r}")
+    k0 = positive("k0", k0)
+    Dc = positive("Dc", Dc)
+    v_min = positive("v_min", v_min)
+    v_max = positive("v_max", v_max)
+    if v_max <= v_min:
+        raise ValueError(f"v_max must be > v_min = {v_min!r}, got {v_max!r}")
+    law = law.bind(k0)
+    K = k0 * Dc
+    if isinstance(law, HyperbolicLaw):
+        A, B = law.A, law.B
+        disc = A * (A - 4.0 * K * B)
+        if disc < 0.0 or A == 0.0:
+            return CriticalVelocity(k0, Dc, math.nan, math.nan, (), (), "quadratic")
+        v_plus = (A - 2.0 * K * B + math.sqrt(disc)) / (2.0 * K)
+        v_minus = B * B / v_plus
+        roots = (v_minus, v_plus) if v_minus < v_plus else (v_plus,)
+        unstable = ((v_minus, v_plus),) if v_minus < v_plus else ()
+        return CriticalVelocity(k0, Dc, v_plus, v_minus, roots, unstable, "quadratic")
+    if isinstance(law, LogLaw):
+        w = law.b - law.a
+        if w > K:
+            return CriticalVelocity(k0, Dc, math.inf, 0.0, (), ((0.0, math.inf),), "constant W")
+        return CriticalVelocity(k0, Dc, math.nan, math.nan, (), (), "constant W")
+    v = np.geomspace(v_min, v_max, 2401)
+    f = law.weakening(v) - K
+    roots = []
+    for i in np.flatnonzero(np.sign(f[:-1]) * np.sign(f[1:]) < 0):
+        roots.append(brentq(lambda x: float(law.weakening(np.array([math.exp(x)]))[0]) - K,
+                            math.log(v[i]), math.log(v[i + 1]), xtol=1e-14))
+    roots = [math.exp(r) for r in roots]
+    edges = [0.0] + roots + [math.inf]
+    unstable = []
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        if lo == 0.0 and hi == math.inf:
+            probe = 1.0
+        elif lo == 0.0:
+            probe = hi / 10.0
+        elif hi == math.inf:
+            probe = lo * 10.0
+        else:
+            probe = math.sqrt(lo * hi)
+        if float(law.weakening(np.array([probe]))[0]) > K:
+            unstable.append((lo, hi))
+    if not unstable:
+        return CriticalVelocity(k0, Dc, math.nan, math.nan, tuple(roots), (), "scan")
+    lo, hi = unstable[-1]
+    return CriticalVelocity(k0, Dc, hi, lo, tuple(roots), tuple(unstable), "scan")
+
+
+def fit_power_law(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
+    """Least-squares fit of ln y = ln c + beta ln x; returns (beta, stderr of beta, c,
+    stderr of ln c)."""
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if x.size < 3:
+        raise ValueError(f"need at least 3 points for a fit with an uncertainty, got {x.size}")
+    res = linregress(np.log(x), np.log(y))
+    return float(res.slope), float(res.stderr), float(math.exp(res.intercept)), float(res.intercept_stderr)
+
+
+@dataclass
+class HopfFit:
+    r"""Amplitude :math:`\sigma_{max} - \sigma_{min}` against :math:`V^c - V` near the
+    bifurcation (:func:`hopf_scaling`).
+
+    ``exponent`` and ``exponent_stderr`` come from a least-squares fit of
+    :math:`\ln(\sigma_{max}-\sigma_{min})` on :math:`\ln(V^c - V)` over the points with
+    :math:`(V^c - V)/V^c \le` ``fit_max``; ``local_exponents`` are the slopes between
+    neighbouring points (they show where the scaling holds).
+    """
+
+    k0: float
+    Vc: float
+    epsilon: np.ndarray          # (Vc - V) / Vc
+    amplitude: np.ndarray
+    sigma_min: np.ndarray
+    sigma_max: np.ndarray
+    exponent: float
+    exponent_stderr: float
+    prefactor: float
+    fit_max: float
+    local_exponents: np.ndarray
+    converged: bool
+
+    def to_frame(self) -> pd.DataFrame:
+        return pd.DataFrame({"k0": self.k0, "Vc": self.Vc, "epsilon": self.epsilon,
+                             "V": self.Vc * (1.0 - self.epsilon), "amplitude": self.amplitude,
+                             "sigma_min": self.sigma_min, "sigma_max": self.sigma_max})
+
+
+def hopf_scaling(model: SpringSlider, epsilon: Sequence[float] | None = None, *,
+                 fit_max: float = 1e-4, options: SolverOptions | None = None) -> HopfFit:
+    r"""Measure the stick-slip amplitude at :math:`V = V^c(1 - \epsilon)` and fit
+    :math:`\sigma_{max} - \sigma_{min} \propto (V^c - V)^\beta`.
+
+    Parameters
+    ----------
+    model : SpringSlider
+    epsilon : sequence of float, optional
+        Relative distances below Vc, in (0, 1); default 12 values from 1e-7 to 1e-1.
+    fit_max : float
+        Only points with epsilon <= fit_max enter the fit (default 1e-4: the scaling
+        region next to the bifurcation).
+    options : SolverOptions, optional
+        Default: cycle_rtol = 1e-11 (the amplitude at epsilon = 1e-7 is ~1e-4 of sigma).
+    """
+    from .solver import limit_cycle
+
+    cv = critical_velocity(model)
+    if not (math.isfinite(cv.Vc) and cv.Vc > 0):
+        raise ValueError(f"no finite critical velocity for k0 = {model.k0!r}, Dc = {model.Dc!r}")
+    eps = np.asarray(np.geomspace(1e-7, 1e-1, 13) if epsilon is None else epsilon, dtype=float)
+    if np.any(~np.isfinite(eps)) or np.any(eps <= 0.0) or np.any(eps >= 1.0):
+        raise ValueError("epsilon must hold values in (0, 1)")
+    options = options or SolverOptions(cycle_rtol=1e-11, rtol=1e-12, atol=1e-14)
+    amp, smin, smax, ok = [], [], [], True
+    for e in eps:
+        r = limit_cycle(model, cv.Vc * (1.0 - e), options=options)
+        ok = ok and r.converged and r.regime == "stick-slip"
+        amp.append(r.sigma_max - r.sigma_min)
+        smin.append(r.sigma_min)
+        smax.append(r.sigma_max)
+    amp = np.array(amp)
+    x = eps * cv.Vc
+    sel = eps <= fit_max
+    beta, dbeta, c, _ = fit_power_law(x[sel], amp[sel])
+    order = np.argsort(x)
+    local = np.diff(np.log(amp[order])) / np.diff(np.log(x[order]))
+    return HopfFit(model.k0, cv.Vc, eps, amp, np.array(smin), np.array(smax), beta, dbeta, c,
+                   fit_max, local, ok)

@@ -1,0 +1,240 @@
+"""Command line: ``python -m rsf {sweep,critical,run} ...``.
+
+* ``sweep``    limit cycles over driving velocities, one CSV row per V
+  (k0, Dc, V, regime, sigma_max, sigma_min, sigma_mean, period, converged, status, ...);
+* ``critical`` the critical velocity from the linear stability analysis (k0, Dc, Vc, ...);
+* ``run``      a time series t, x, sigma, theta, v (and an events file).
+
+Defaults are the paper's: Eq. (10) with A = 0.007, B = 0.078, mu_inf = 1 - 0.05 (k0 + 1),
+and Dc = 0.06.  Exit status: 0 on success, 2 on bad input, 3 if some result did not
+converge or the integration failed (the CSV then says which, in the status/message columns).
+"""
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from typing import Sequence
+
+import numpy as np
+
+from .analysis import critical_velocity
+from .laws import PAPER_A, PAPER_B, PAPER_DC, HyperbolicLaw, LogLaw, TabulatedLaw, ViscoelasticLaw
+from ._validation import positive
+from .params import Protocol, SolverOptions, SpringSlider
+from .solver import simulate, sweep
+
+__all__ = ["main", "build_parser"]
+
+logger = logging.getLogger(__name__)
+
+
+def _floats(text: str) -> list[float]:
+    try:
+        values = [float(x) for x in text.replace(" ", "").split(",") if x]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+    if not values:
+        raise argparse.ArgumentTypeError("expected at least one number")
+    return values
+
+
+def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> None:
+    g = p.add_argument_group("model")
+    if k0_list:
+        g.add_argument("--k0", type=_floats, required=True,
+                       help="driving stiffness k0 > 0 (comma-separated list allowed)")
+    else:
+        g.add_argument("--k0", type=float, required=True, help="driving stiffness k0 > 0")
+    g.add_argument("--Dc", type=float, default=PAPER_DC,
+                   help=f"critical slip distance Dc > 0 (default {PAPER_DC}, the paper's)")
+    g.add_argument("--law", choices=("hyperbolic", "viscoelastic", "log", "table"),
+                   default="hyperbolic",
+                   help="steady-state law: hyperbolic = Eq. (10) A/(v+B) + mu_inf (default); "
+                        "viscoelastic = Eq. (4); log = Eq. (9), mu0 + (a-b) ln(v/v0); "
+                        "table = PCHIP interpolation of a CSV (--table)")
+    g.add_argument("--state-law", choices=("aging", "slip"), default="aging",
+                   help="state evolution: aging (Eq. 8, default) or Ruina slip law (needs --a > 0)")
+    g.add_argument("--a", type=float, default=None,
+                   help="direct effect a >= 0 (default: the law's a for --law log, else 0, "
+                        "the paper's model with stick, slide and instantaneous slip)")
+    h = p.add_argument_group("hyperbolic law, Eq. (10)")
+    h.add_argument("--A", type=float, default=PAPER_A, help=f"amplitude A >= 0 (default {PAPER_A})")
+    h.add_argument("--B", type=float, default=PAPER_B, help=f"velocity scale B > 0 (default {PAPER_B})")
+    h.add_argument("--mu-inf", type=float, default=None,
+                   help="large-velocity friction mu_inf (default: the paper's "
+                        "f_th - zbar (k0 + k1 + k2)/2 = 0.95 - 0.05 k0)")
+    v = p.add_argument_group("viscoelastic law, Eq. (4)")
+    v.add_argument("--f-th", type=float, default=1.0, help="pinning threshold f_th (default 1)")
+    v.add_argument("--zbar", type=float, default=0.1, help="mean well spacing zbar > 0 (default 0.1)")
+    v.add_argument("--k1", type=float, default=0.1, help="elastic coupling k1 >= 0 (default 0.1)")
+    v.add_argument("--k2", type=float, default=0.9, help="viscoelastic spring k2 > 0 (default 0.9)")
+    v.add_argument("--eta-u", type=float, default=1.0, help="dashpot viscosity eta_u > 0 (default 1)")
+    lg = p.add_argument_group("log law, Eq. (9) / Eq. (7)")
+    lg.add_argument("--mu0", type=float, default=0.6, help="reference friction mu0 (default 0.6)")
+    lg.add_argument("--b", type=float, default=0.015, help="evolution effect b >= 0 (default 0.015)")
+    lg.add_argument("--law-a", type=float, default=0.01,
+                    help="a of the log steady state mu0 + (a-b) ln(v/v0) (default 0.01)")
+    lg.add_argument("--v0", type=float, default=1.0, help="reference velocity v0 > 0 (default 1)")
+    t = p.add_argument_group("table law")
+    t.add_argument("--table", default=None, help="CSV file with a velocity and a friction column")
+    t.add_argument("--table-v-column", default="V", help="velocity column (default V)")
+    t.add_argument("--table-mu-column", default="sigma", help="friction column (default sigma)")
+    t.add_argument("--table-where", default=None,
+                   help="pandas query selecting rows, e.g. \"regime == 'steady'\"")
+
+
+def _add_solver_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("solver")
+    g.add_argument("--rtol", type=float, default=1e-10, help="CVODE relative tolerance (default 1e-10)")
+    g.add_argument("--atol", type=float, default=1e-12, help="CVODE absolute tolerance (default 1e-12)")
+    g.add_argument("--cycle-rtol", type=float, default=1e-8,
+                   help="limit cycle converged when sigma_max, sigma_min and the period change by "
+                        "less than this from one cycle to the next (default 1e-8)")
+    g.add_argument("--max-cycles", type=int, default=20000, help="give up after this many cycles")
+    g.add_argument("--no-accelerate", action="store_true",
+                   help="simulate every cycle of the transient (no Aitken extrapolation)")
+
+
+def _law(args: argparse.Namespace, k0: float):
+    positive("k0", k0)
+    if args.law == "hyperbolic":
+        return HyperbolicLaw(A=args.A, B=args.B, mu_inf=args.mu_inf).bind(k0)
+    if args.law == "viscoelastic":
+        return ViscoelasticLaw(f_th=args.f_th, zbar=args.zbar, k1=args.k1, k2=args.k2,
+                               eta_u=args.eta_u, k0=k0)
+    if args.law == "log":
+        return LogLaw(mu0=args.mu0, a=args.law_a, b=args.b, v0=args.v0)
+    if args.table is None:
+        raise ValueError("--law table needs --table FILE.csv")
+    return TabulatedLaw.from_csv(args.table, args.table_v_column, args.table_mu_column,
+                                 args.table_where)
+
+
+def _model(args: argparse.Namespace, k0: float) -> SpringSlider:
+    return SpringSlider(law=_law(args, k0), k0=k0, Dc=args.Dc, a=args.a, state_law=args.state_law)
+
+
+def _options(args: argparse.Namespace) -> SolverOptions:
+    return SolverOptions(rtol=args.rtol, atol=args.atol, cycle_rtol=args.cycle_rtol,
+                         max_cycles=args.max_cycles, accelerate=not args.no_accelerate)
+
+
+def _write(frame, out: str | None) -> None:
+    if out is None or out == "-":
+        frame.to_csv(sys.stdout, index=False)
+    else:
+        frame.to_csv(out, index=False)
+        print(f"wrote {len(frame)} rows to {out}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m rsf",
+        description="Rate-and-state spring-slider (Landes, Rosso & Jagla 2015, Sec. V): limit "
+                    "cycles, critical velocity and time series.",
+        epilog="Exit status: 0 success, 2 bad input, 3 some result not converged or failed.")
+    parser.add_argument("-v", "--verbose", action="store_true", help="log progress (INFO)")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    ps = sub.add_parser("sweep", help="limit cycles over driving velocities (one CSV row per V)",
+                        description="Run to the attractor at each V and write k0, Dc, V, regime "
+                                    "(steady or stick-slip), sigma_max, sigma_min, sigma_mean, "
+                                    "period, converged, status, message, n_cycles.")
+    ps.add_argument("--V", type=_floats, default=None,
+                    help="driving velocities, comma-separated (e.g. 0.1,1,10)")
+    ps.add_argument("--V-range", type=float, nargs=3, metavar=("VMIN", "VMAX", "N"), default=None,
+                    help="alternatively N log-spaced velocities from VMIN to VMAX")
+    ps.add_argument("--out", default=None, help="output CSV (default: standard output)")
+    _add_model_options(ps)
+    _add_solver_options(ps)
+
+    pc = sub.add_parser("critical", help="critical velocity from the linear stability analysis",
+                        description="Solve k0 Dc = -V dmu_ss/dV and write k0, Dc, Vc (the upper "
+                                    "end of the unstable band, the paper's V^c), V_lower (its "
+                                    "lower end) and the method.")
+    pc.add_argument("--out", default=None, help="output CSV (default: standard output)")
+    _add_model_options(pc, k0_list=True)
+
+    pr = sub.add_parser("run", help="time series t, x, sigma, theta, v (and events)",
+                        description="Integrate from the (perturbed) steady state and write the "
+                                    "samples t, x, sigma, theta, v; a slip appears as two rows "
+                                    "at one time.")
+    pr.add_argument("--V", type=float, default=None, help="constant driving velocity V > 0")
+    pr.add_argument("--steps", default=None,
+                    help="velocity steps V1:T1,V2:T2,...,Vn (velocity:duration, last open-ended)")
+    pr.add_argument("--shs", type=float, nargs=3, metavar=("V", "SLIDE", "HOLD"), default=None,
+                    help="slide-hold-slide: slide at V for SLIDE, hold for HOLD, slide again")
+    pr.add_argument("--t-end", type=float, required=True, help="end time > 0")
+    pr.add_argument("--out", required=True, help="output CSV for the time series")
+    pr.add_argument("--events", default=None, help="output CSV for the events t, kind, sigma, theta, x")
+    _add_model_options(pr)
+    _add_solver_options(pr)
+    return parser
+
+
+def _protocol(args: argparse.Namespace) -> tuple[float | None, Protocol | None]:
+    given = [x is not None for x in (args.V, args.steps, args.shs)]
+    if sum(given) != 1:
+        raise ValueError("give exactly one of --V, --steps, --shs")
+    if args.V is not None:
+        return args.V, None
+    if args.shs is not None:
+        V, slide, hold = args.shs
+        return None, Protocol.slide_hold_slide(V, slide, hold)
+    velocities, durations = [], []
+    for i, item in enumerate(args.steps.split(",")):
+        parts = item.split(":")
+        try:
+            velocities.append(float(parts[0]))
+            if len(parts) > 1:
+                durations.append(float(parts[1]))
+        except ValueError:
+            raise ValueError(f"--steps item {i} must be velocity[:duration], got {item!r}") from None
+    return None, Protocol.velocity_steps(velocities, durations)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                        format="%(levelname)s %(name)s: %(message)s")
+    try:
+        if args.command == "critical":
+            import pandas as pd
+
+            rows = [critical_velocity(_model(args, k0)).to_frame() for k0 in args.k0]
+            frame = pd.concat(rows, ignore_index=True)
+            _write(frame, args.out)
+            return 0
+        model = _model(args, args.k0)
+        options = _options(args)
+        if args.command == "sweep":
+            if (args.V is None) == (args.V_range is None):
+                raise ValueError("give exactly one of --V and --V-range")
+            if args.V is not None:
+                velocities = args.V
+            else:
+                vmin, vmax, n = args.V_range
+                if not (vmin > 0 and vmax > vmin and n >= 1 and float(n).is_integer()):
+                    raise ValueError("--V-range needs 0 < VMIN < VMAX and an integer N >= 1")
+                velocities = np.geomspace(vmin, vmax, int(n))
+            result = sweep(model, velocities, options=options, progress=args.verbose)
+            _write(result.to_frame(), args.out)
+            if not result.all_converged:
+                print(f"warning: {result.message}", file=sys.stderr)
+                return 3
+            return 0
+        V, protocol = _protocol(args)
+        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options)
+        _write(traj.to_frame(), args.out)
+        if args.events:
+            traj.events_frame().to_csv(args.events, index=False)
+            print(f"wrote {len(traj.events)} events to {args.events}")
+        if not traj.success:
+            print(f"warning: {traj.message}", file=sys.stderr)
+            return 3
+        return 0
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2

@@ -1,0 +1,271 @@
+r"""What the user sets: the spring-slider, the driving protocol, the initial state and the
+solver options.  All are small frozen dataclasses that validate themselves on
+construction, so that a bad parameter fails at once and names itself.
+
+The model (paper, Sec. V.B; :math:`F_N = 1`, no inertia):
+
+.. math::
+    \sigma = k_0\,(X(t) - x) \quad \text{(Eq. 12, } X = Vt \text{ for constant driving)},\qquad
+    \dot\theta = 1 - \frac{\theta v}{D_c} \quad \text{(Eq. 8)},
+
+    \mu(v, \theta) = \mu_{ss}(D_c/\theta) + a \ln\frac{v\,\theta}{D_c}
+    \quad \text{(Eq. 11 for } a = 0\text{; Eq. 7 for the log law)}.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+from ._validation import choice, nonnegative, positive, positive_int
+from .laws import PAPER_DC, HyperbolicLaw, LogLaw, SteadyStateLaw
+
+__all__ = ["SpringSlider", "Protocol", "InitialState", "SolverOptions", "standard_rs"]
+
+
+@dataclass(frozen=True)
+class SpringSlider:
+    r"""A block pulled through a spring of stiffness :math:`k_0` on a rate-and-state
+    interface.
+
+    Parameters
+    ----------
+    law : SteadyStateLaw
+        The steady-state friction :math:`\mu_{ss}(v)`; default the paper's Eq. (10),
+        :class:`~rsf.laws.HyperbolicLaw` with :math:`\mu_\infty` resolved for ``k0``.
+    k0 : float
+        Driving stiffness, > 0.
+    Dc : float
+        Critical slip distance, > 0 (paper: 0.06).
+    a : float or None
+        Direct effect :math:`a \ge 0`.  ``None``: the law's ``a`` for a
+        :class:`~rsf.laws.LogLaw` (Eq. 7), otherwise 0 (the paper's model, Eq. 11).
+        With :math:`a = 0` the motion splits into stick, slide and instantaneous slip; with
+        :math:`a > 0` it is a regular ODE.
+    state_law : {'aging', 'slip'}
+        Eq. (8) (Dieterich aging) or the Ruina slip law
+        :math:`\dot\theta = -(\theta v/D_c)\ln(\theta v/D_c)`; the slip law needs
+        :math:`a > 0` (with :math:`a = 0` the instantaneous slip is undefined for it).
+    """
+
+    law: SteadyStateLaw = field(default_factory=HyperbolicLaw)
+    k0: float = 0.01
+    Dc: float = PAPER_DC
+    a: float | None = None
+    state_law: str = "aging"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.law, SteadyStateLaw):
+            raise ValueError(f"law must be a SteadyStateLaw (HyperbolicLaw, ViscoelasticLaw, LogLaw, "
+                             f"TabulatedLaw, CallableLaw), got {self.law!r}")
+        k0 = positive("k0", self.k0)
+        object.__setattr__(self, "k0", k0)
+        object.__setattr__(self, "Dc", positive("Dc", self.Dc))
+        object.__setattr__(self, "law", self.law.bind(k0))
+        a = self.a
+        if a is None:
+            a = self.law.a if isinstance(self.law, LogLaw) else 0.0
+        object.__setattr__(self, "a", nonnegative("a", a))
+        choice("state_law", self.state_law, ("aging", "slip"))
+        if self.state_law == "slip" and self.a == 0.0:
+            raise ValueError("state_law='slip' needs a direct effect a > 0 (with a = 0 the "
+                             "instantaneous slip of the slip law is undefined); got a = 0")
+
+    @property
+    def K(self) -> float:
+        r""":math:`k_0 D_c`, the only combination in which :math:`D_c` enters (with time
+        measured in units of :math:`D_c`)."""
+        return self.k0 * self.Dc
+
+    def sigma_steady(self, V: float) -> float:
+        r"""Friction of steady sliding at :math:`V`, :math:`\mu_{ss}(V)`."""
+        return float(self.law.mu_ss(positive("V", V)))
+
+    def describe(self) -> dict[str, float | str]:
+        """Parameters as a flat dict (for tables)."""
+        out: dict[str, float | str] = {"k0": self.k0, "Dc": self.Dc, "a": self.a,
+                                       "state_law": self.state_law}
+        out.update(self.law.describe())
+        return out
+
+
+def standard_rs(mu0: float = 0.6, a: float = 0.01, b: float = 0.015, Dc: float = 1e-5,
+                k0: float = 1e3, v0: float = 1e-6, state_law: str = "aging") -> SpringSlider:
+    r"""The classic rate-and-state spring-slider (Eq. 7 with Eq. 8 or the slip law):
+
+    .. math:: \mu = \mu_0 + a\ln(v/v_0) + b\ln(\theta v_0/D_c).
+
+    Defaults are laboratory-like (SI units: m, s), as in rsfmodel's examples.
+    """
+    return SpringSlider(law=LogLaw(mu0=mu0, a=a, b=b, v0=v0), k0=k0, Dc=Dc, a=a,
+                        state_law=state_law)
+
+
+@dataclass(frozen=True, eq=False)
+class Protocol:
+    r"""Piecewise-constant load-point velocity: ``velocities[i]`` from ``times[i]`` to
+    ``times[i + 1]`` (the last one forever).  ``times[0]`` must be 0.
+
+    Build it with :meth:`constant`, :meth:`velocity_steps` or :meth:`slide_hold_slide`.
+    """
+
+    times: np.ndarray
+    velocities: np.ndarray
+
+    def __post_init__(self) -> None:
+        times = np.atleast_1d(np.asarray(self.times, dtype=float)).copy()
+        vel = np.atleast_1d(np.asarray(self.velocities, dtype=float)).copy()
+        if times.size != vel.size or times.size == 0:
+            raise ValueError(f"times and velocities must be non-empty and of equal length, got "
+                             f"{times.size} and {vel.size}")
+        if times[0] != 0.0:
+            raise ValueError(f"times[0] must be 0, got {times[0]!r}")
+        if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0.0):
+            raise ValueError("times must be finite and strictly increasing")
+        if not np.all(np.isfinite(vel)) or np.any(vel < 0.0):
+            raise ValueError("velocities must be finite and >= 0")
+        times.setflags(write=False)
+        vel.setflags(write=False)
+        object.__setattr__(self, "times", times)
+        object.__setattr__(self, "velocities", vel)
+
+    @classmethod
+    def constant(cls, V: float) -> Protocol:
+        """Constant driving at ``V`` > 0."""
+        return cls(np.array([0.0]), np.array([positive("V", V)]))
+
+    @classmethod
+    def velocity_steps(cls, velocities: Sequence[float], durations: Sequence[float]) -> Protocol:
+        """Velocity ``velocities[i]`` for ``durations[i]`` (the last one until the end of the
+        run; ``durations`` may have one entry fewer than ``velocities``)."""
+        vel = [nonnegative(f"velocities[{i}]", v) for i, v in enumerate(velocities)]
+        dur = [positive(f"durations[{i}]", d) for i, d in enumerate(durations)]
+        if len(dur) not in (len(vel), len(vel) - 1) or not vel:
+            raise ValueError("durations must have as many entries as velocities, or one fewer")
+        times = np.concatenate([[0.0], np.cumsum(dur[: len(vel) - 1])])
+        return cls(times, np.array(vel))
+
+    @classmethod
+    def slide_hold_slide(cls, V: float, slide_time: float, hold_time: float,
+                         V_reload: float | None = None) -> Protocol:
+        """Slide at ``V`` for ``slide_time``, hold (V = 0) for ``hold_time``, then slide at
+        ``V_reload`` (default ``V``)."""
+        V = positive("V", V)
+        V2 = V if V_reload is None else positive("V_reload", V_reload)
+        return cls.velocity_steps([V, 0.0, V2], [slide_time, positive("hold_time", hold_time)])
+
+    def velocity_at(self, t: float) -> float:
+        """The load-point velocity at time ``t`` (right-continuous)."""
+        if self.times.size == 1:
+            return float(self.velocities[0])
+        i = int(np.searchsorted(self.times, t, side="right")) - 1
+        return float(self.velocities[max(i, 0)])
+
+    def segment_end(self, t: float) -> float:
+        """The next change of velocity strictly after ``t`` (inf if none)."""
+        if self.times.size == 1:
+            return math.inf
+        i = int(np.searchsorted(self.times, t, side="right"))
+        return float(self.times[i]) if i < self.times.size else math.inf
+
+    def load_point(self, t: float) -> float:
+        r"""Load-point displacement :math:`X(t) = \int_0^t V\,\mathrm{d}t'`."""
+        if self.times.size == 1:
+            return float(self.velocities[0]) * t
+        i = int(np.searchsorted(self.times, t, side="right")) - 1
+        i = max(i, 0)
+        dt = np.diff(self.times[: i + 1])
+        return float(np.dot(dt, self.velocities[:i]) + self.velocities[i] * (t - self.times[i]))
+
+    @property
+    def is_constant(self) -> bool:
+        return self.times.size == 1
+
+
+@dataclass(frozen=True)
+class InitialState:
+    r"""Initial state.  ``theta`` defaults to the steady state at the initial driving
+    velocity times ``1 + perturbation``; ``sigma`` defaults to the threshold
+    :math:`\phi(\theta)` (for :math:`a > 0`: the friction at :math:`v = V`); ``x`` is 0.
+
+    Parameters
+    ----------
+    theta : float or None
+        State variable, > 0.
+    sigma : float or None
+        Spring force (for :math:`a = 0`: must be finite; above the threshold the run starts
+        with a slip).
+    perturbation : float
+        Relative offset of the default theta from steady state, > -1 (default 1e-3).
+    """
+
+    theta: float | None = None
+    sigma: float | None = None
+    perturbation: float = 1e-3
+
+    def __post_init__(self) -> None:
+        if self.theta is not None:
+            object.__setattr__(self, "theta", positive("theta", self.theta))
+        if self.sigma is not None:
+            s = float(self.sigma)
+            if not math.isfinite(s):
+                raise ValueError(f"sigma must be a finite number, got {self.sigma!r}")
+            object.__setattr__(self, "sigma", s)
+        pert = float(self.perturbation)
+        if not (math.isfinite(pert) and pert > -1.0):
+            raise ValueError(f"perturbation must be a finite number > -1, got {self.perturbation!r}")
+        object.__setattr__(self, "perturbation", pert)
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    r"""Numerical settings.
+
+    Parameters
+    ----------
+    rtol : float
+        CVODE relative tolerance, in [1e-14, 1e-2] (default 1e-10).
+    atol : float
+        CVODE absolute tolerance relative to each variable's natural scale, in
+        [1e-16, 1e-2] (default 1e-12).
+    cycle_rtol : float
+        Limit cycle converged when :math:`\sigma_{max}`, :math:`\sigma_{min}` and the period
+        change by less than this (relative) from one cycle to the next; also the relative
+        distance :math:`|\ln(u/V)|` at which a stable slide is declared steady.  In
+        [1e-14, 1e-1], default 1e-8.
+    max_cycles : int
+        Give up (status ``max_cycles``) after this many cycles (default 20000).
+    max_events : int
+        Give up after this many events in one run (default 2,000,000).
+    accelerate : bool
+        Extrapolate the cycle-to-cycle map (Aitken) to skip slow transients; the convergence
+        test is always made on two consecutive simulated cycles (default True).
+    method : {'Adams', 'BDF'}
+        CVODE method for the slide phases (default 'Adams'; the a > 0 ODE always uses BDF).
+    max_num_steps : int
+        CVODE steps allowed per output interval (default 1,000,000).
+    """
+
+    rtol: float = 1e-10
+    atol: float = 1e-12
+    cycle_rtol: float = 1e-8
+    max_cycles: int = 20000
+    max_events: int = 2_000_000
+    accelerate: bool = True
+    method: str = "Adams"
+    max_num_steps: int = 1_000_000
+
+    def __post_init__(self) -> None:
+        from ._validation import in_range
+
+        object.__setattr__(self, "rtol", in_range("rtol", self.rtol, 1e-14, 1e-2))
+        object.__setattr__(self, "atol", in_range("atol", self.atol, 1e-16, 1e-2))
+        object.__setattr__(self, "cycle_rtol", in_range("cycle_rtol", self.cycle_rtol, 1e-14, 1e-1))
+        object.__setattr__(self, "max_cycles", positive_int("max_cycles", self.max_cycles))
+        object.__setattr__(self, "max_events", positive_int("max_events", self.max_events))
+        object.__setattr__(self, "max_num_steps", positive_int("max_num_steps", self.max_num_steps))
+        if not isinstance(self.accelerate, bool):
+            raise ValueError(f"accelerate must be True or False, got {self.accelerate!r}")
+        choice("method", self.method, ("Adams", "BDF"))

@@ -1,0 +1,217 @@
+"""Result objects: named fields, a status with a message, and ``to_frame()``.
+
+Status codes (``STATUS_MESSAGES``): non-negative values are successes, negative values
+failures.  A limit-cycle search never ends silently unconverged: it reports
+``MAX_CYCLES`` (or another negative status) and ``converged = False``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "STATUS_MESSAGES",
+    "Status",
+    "Event",
+    "Trajectory",
+    "CycleResult",
+    "SweepResult",
+]
+
+
+class Status:
+    """Named outcomes (integers, like scipy's ``OdeResult.status``)."""
+
+    TIME_LIMIT = 0        #: reached t_end
+    STEADY = 1            #: steady sliding reached (a stable steady state within tolerance)
+    CONVERGED = 2         #: limit cycle converged
+    MAX_CYCLES = -1       #: limit cycle not converged within max_cycles
+    MAX_EVENTS = -2       #: too many events
+    RUNAWAY = -3          #: a slip that never arrests (unbounded weakening)
+    SOLVER_FAILED = -4    #: CVODE or a root search failed
+    DEGENERATE = -5       #: repeated zero-length phases at a degenerate point
+
+
+STATUS_MESSAGES: dict[int, str] = {
+    Status.TIME_LIMIT: "reached the end time",
+    Status.STEADY: "steady sliding reached",
+    Status.CONVERGED: "limit cycle converged",
+    Status.MAX_CYCLES: "limit cycle not converged within max_cycles",
+    Status.MAX_EVENTS: "too many events",
+    Status.RUNAWAY: "runaway slip: the slip never arrests (weakening exceeds the spring)",
+    Status.SOLVER_FAILED: "the integrator or a root search failed",
+    Status.DEGENERATE: "repeated zero-length phases at a degenerate (tangent) point",
+}
+
+
+@dataclass(frozen=True)
+class Event:
+    """A switch of phase (``kind`` like ``'stick->slip'``) or another marked instant
+    (``'steady'``, ``'drive'``, ``'extremum'``, ``'restart'``, ``'sigma_max'``,
+    ``'sigma_min'``)."""
+
+    t: float
+    kind: str
+    sigma: float
+    theta: float
+    x: float
+
+
+def _events_frame(events: list[Event]) -> pd.DataFrame:
+    return pd.DataFrame([asdict(e) for e in events], columns=["t", "kind", "sigma", "theta", "x"])
+
+
+@dataclass
+class Trajectory:
+    """A time series from :func:`rsf.simulate`.
+
+    Attributes
+    ----------
+    t, x, sigma, theta, v : ndarray
+        Samples (a slip appears as two samples at the same time).
+    events : list of Event
+        Every event of the run.
+    status : int
+        One of :class:`Status`; ``success`` is ``status >= 0``.
+    message : str
+        Human-readable status.
+    params : dict
+        Model parameters.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    sigma: np.ndarray
+    theta: np.ndarray
+    v: np.ndarray
+    events: list[Event]
+    status: int
+    message: str
+    params: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return self.status >= 0
+
+    def to_frame(self) -> pd.DataFrame:
+        """Columns t, x, sigma, theta, v."""
+        return pd.DataFrame({"t": self.t, "x": self.x, "sigma": self.sigma, "theta": self.theta,
+                             "v": self.v})
+
+    def events_frame(self) -> pd.DataFrame:
+        """Columns t, kind, sigma, theta, x."""
+        return _events_frame(self.events)
+
+
+@dataclass
+class CycleResult:
+    """The attractor at one driving velocity, from :func:`rsf.limit_cycle`.
+
+    Attributes
+    ----------
+    regime : str
+        ``'steady'`` or ``'stick-slip'`` (any converged oscillation), or ``'unknown'`` when
+        the search failed.
+    sigma_max, sigma_min, sigma_mean : float
+        Extrema and time average of sigma over the last cycle (all equal to
+        :math:`\\mu_{ss}(V)` for steady sliding).
+    period : float
+        Duration of the last cycle (nan for steady sliding).
+    converged : bool
+        Whether the cycle (or the steady state) was reached within tolerance.
+    status, message
+        Outcome (:class:`Status`).
+    n_cycles : int
+        Cycles simulated.
+    relative_change : float
+        Largest relative change of (sigma_max, sigma_min, period) between the last two
+        cycles.
+    sequence : tuple of str
+        Event kinds of the last cycle.
+    events : list of Event
+        Events of the last cycle.
+    """
+
+    V: float
+    regime: str
+    sigma_max: float
+    sigma_min: float
+    sigma_mean: float
+    period: float
+    converged: bool
+    status: int
+    message: str
+    n_cycles: int = 0
+    relative_change: float = math.nan
+    sequence: tuple[str, ...] = ()
+    events: list[Event] = field(default_factory=list)
+    params: dict[str, Any] = field(default_factory=dict)
+    run_time: float = math.nan
+
+    @property
+    def success(self) -> bool:
+        return self.status >= 0
+
+    @property
+    def amplitude(self) -> float:
+        """sigma_max - sigma_min."""
+        return self.sigma_max - self.sigma_min
+
+    def row(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        out.update({k: self.params[k] for k in ("k0", "Dc") if k in self.params})
+        out.update(V=self.V, regime=self.regime, sigma_max=self.sigma_max,
+                   sigma_min=self.sigma_min, sigma_mean=self.sigma_mean, period=self.period,
+                   converged=self.converged, status=self.status, message=self.message,
+                   n_cycles=self.n_cycles, relative_change=self.relative_change,
+                   sequence=" ".join(self.sequence))
+        return out
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row: k0, Dc, V, regime, sigma_max, sigma_min, sigma_mean, period, ..."""
+        return pd.DataFrame([self.row()])
+
+    def events_frame(self) -> pd.DataFrame:
+        return _events_frame(self.events)
+
+
+@dataclass
+class SweepResult:
+    """Limit cycles over a list of driving velocities (:func:`rsf.sweep`)."""
+
+    results: list[CycleResult]
+    params: dict[str, Any] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.results)
+
+    def __iter__(self):
+        return iter(self.results)
+
+    def __getitem__(self, i: int) -> CycleResult:
+        return self.results[i]
+
+    @property
+    def all_converged(self) -> bool:
+        return all(r.converged for r in self.results)
+
+    @property
+    def status(self) -> int:
+        """The worst status of the sweep."""
+        return min((r.status for r in self.results), default=Status.CONVERGED)
+
+    @property
+    def message(self) -> str:
+        bad = [r for r in self.results if not r.converged]
+        if not bad:
+            return f"all {len(self.results)} points converged"
+        return (f"{len(bad)} of {len(self.results)} points not converged: "
+                + "; ".join(f"V={r.V:g}: {r.message}" for r in bad[:5]))
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per V with k0, Dc, V, regime, sigma_max, sigma_min, sigma_mean, period."""
+        return pd.DataFrame([r.row() for r in self.results])

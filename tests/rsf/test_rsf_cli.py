@@ -1,0 +1,96 @@
+"""``python -m rsf``: the sweep, critical and run commands, their columns, and bad input."""
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+import rsf
+from rsf.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_sweep_writes_one_row_per_V(tmp_path):
+    out = tmp_path / "sweep.csv"
+    assert main(["sweep", "--k0", "0.01", "--Dc", "0.06", "--V", "0.1,1,20", "--out", str(out)]) == 0
+    df = pd.read_csv(out)
+    assert list(df.columns[:8]) == ["k0", "Dc", "V", "regime", "sigma_max", "sigma_min",
+                                    "sigma_mean", "period"]
+    assert list(df.V) == [0.1, 1.0, 20.0]
+    assert list(df.regime) == ["stick-slip", "stick-slip", "steady"]
+    direct = rsf.limit_cycle(rsf.SpringSlider(k0=0.01), 1.0)
+    assert df.sigma_max[1] == pytest.approx(direct.sigma_max, abs=1e-15)
+
+
+def test_sweep_law_options(tmp_path):
+    out = tmp_path / "sweep.csv"
+    assert main(["sweep", "--k0", "0.3", "--V", "0.1", "--A", "0.007", "--B", "0.078",
+                 "--mu-inf", "0.9", "--out", str(out)]) == 0
+    got = pd.read_csv(out)
+    direct = rsf.limit_cycle(rsf.SpringSlider(rsf.HyperbolicLaw(mu_inf=0.9), k0=0.3), 0.1)
+    assert got.sigma_min[0] == pytest.approx(direct.sigma_min, abs=1e-15)
+    # a table written by another tool
+    table = tmp_path / "micro.csv"
+    V = [0.01, 0.1, 1.0, 10.0, 100.0]
+    pd.DataFrame({"V": V, "sigma": rsf.HyperbolicLaw(mu_inf=0.9).mu_ss(V)}).to_csv(table, index=False)
+    assert main(["sweep", "--k0", "0.3", "--law", "table", "--table", str(table), "--V-range",
+                 "0.05", "1", "3", "--out", str(out)]) == 0
+    assert len(pd.read_csv(out)) == 3
+
+
+def test_critical_writes_k0_Dc_Vc(tmp_path):
+    out = tmp_path / "critical.csv"
+    assert main(["critical", "--k0", "0.3,0.01", "--Dc", "0.06", "--out", str(out)]) == 0
+    df = pd.read_csv(out)
+    assert list(df.columns[:3]) == ["k0", "Dc", "Vc"]
+    assert df.Vc[1] == pytest.approx(rsf.critical_velocity(rsf.HyperbolicLaw(), 0.01, 0.06).Vc, rel=1e-14)
+
+
+def test_run_writes_series_and_events(tmp_path):
+    out, ev = tmp_path / "run.csv", tmp_path / "events.csv"
+    assert main(["run", "--k0", "0.3", "--V", "0.05", "--t-end", "20", "--out", str(out),
+                 "--events", str(ev)]) == 0
+    series, events = pd.read_csv(out), pd.read_csv(ev)
+    assert list(series.columns) == ["t", "x", "sigma", "theta", "v"]
+    assert list(events.columns) == ["t", "kind", "sigma", "theta", "x"]
+    assert "slide->slip" in set(events.kind)
+    assert main(["run", "--k0", "0.3", "--shs", "1", "5", "2", "--t-end", "12", "--out", str(out)]) == 0
+    assert main(["run", "--k0", "0.3", "--steps", "1:5,3", "--t-end", "12", "--out", str(out)]) == 0
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["sweep", "--k0", "-1", "--V", "1"], "k0 must be a finite number > 0"),
+    (["sweep", "--k0", "0.1", "--V", "0"], "velocities\\[0\\] must be a finite number > 0"),
+    (["sweep", "--k0", "0.1", "--Dc", "0", "--V", "1"], "Dc must be a finite number > 0"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--rtol", "5"], "rtol must lie in"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--B", "0"], "B must be a finite number > 0"),
+    (["sweep", "--k0", "0.1"], "exactly one of --V and --V-range"),
+    (["run", "--k0", "0.1", "--t-end", "1", "--out", "x.csv"], "exactly one of --V, --steps, --shs"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--law", "table"], "--law table needs --table"),
+])
+def test_bad_input_exit_code_and_message(argv, match, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert re.search(match, err)
+
+
+def test_unconverged_sweep_exits_3(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    code = main(["sweep", "--k0", "0.3", "--V", "0.2029", "--max-cycles", "3", "--no-accelerate",
+                 "--out", str(out)])
+    assert code == 3
+    assert "not converged" in capsys.readouterr().err
+    assert pd.read_csv(out).converged[0] == False  # noqa: E712
+
+
+def test_module_entry_point_help():
+    res = subprocess.run([sys.executable, "-m", "rsf", "sweep", "--help"], cwd=ROOT,
+                         capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0
+    for option in ("--k0", "--Dc", "--V", "--A", "--B", "--mu-inf", "--out", "--law", "--cycle-rtol"):
+        assert option in res.stdout
