@@ -53,6 +53,7 @@ __all__ = [
     "stationary_stress_nblock",
     "stick_slip_extrema_nblock",
     "sigma_deterministic_steady",
+    "sigma_deterministic_steady_finite_n",
     "sigma_fast_limit",
     "sigma_slow_limit",
     "reference_simulate",
@@ -494,18 +495,20 @@ def simulate_nblock(
 # ---------------------------------------------------------------------------------------
 @dataclass
 class StationaryStress:
-    """The stationary stress of a steady-sliding run, by batch means.
+    r"""The stationary stress of a steady-sliding run, by batch means.
 
     ``sigma_mean`` is the mean of ``n_batches`` exact time averages of sigma over
     consecutive windows of length ``batch_length`` after a discarded transient of
-    ``t_transient``; ``sigma_stderr`` their standard deviation over sqrt(n_batches).
-    ``lag1_autocorrelation`` of the batch means should be small (else batches are too
-    short and the error is underestimated). ``regime`` is ``"stick-slip"`` if global
+    ``t_transient``; ``sigma_stderr_naive`` their standard deviation over sqrt(n_batches),
+    and ``sigma_stderr`` the same inflated by :math:`\sqrt{(1+\rho)/(1-\rho)}` (the AR(1)
+    correction) when the lag-1 autocorrelation :math:`\rho` of the batch means is positive.
+    A large :math:`\rho` means the batches are too short. ``regime`` is ``"stick-slip"`` if global
     shocks occurred during the measurement (the mean is then not a stationary stress).
     """
 
     sigma_mean: float
     sigma_stderr: float
+    sigma_stderr_naive: float
     batch_means: np.ndarray
     batch_length: float
     t_transient: float
@@ -591,9 +594,13 @@ def stationary_stress_nblock(
         status = "correlated"
         message = f"batch means are correlated (lag-1 autocorrelation {lag1:.2f}): use longer batches"
         logger.warning("stationary_stress_nblock(V=%g): %s", v, message)
+    naive = float(batches.std(ddof=1) / math.sqrt(batches.size))
+    rho = min(max(lag1, 0.0), 0.9) if math.isfinite(lag1) else 0.0
+    inflation = math.sqrt((1.0 + rho) / (1.0 - rho))
     return StationaryStress(
         sigma_mean=float(batches.mean()),
-        sigma_stderr=float(batches.std(ddof=1) / math.sqrt(batches.size)),
+        sigma_stderr=naive * inflation,
+        sigma_stderr_naive=naive,
         batch_means=batches,
         batch_length=batch_length,
         t_transient=n_skip * batch_length,
@@ -642,7 +649,7 @@ def stick_slip_extrema_nblock(
     n_blocks: int,
     *,
     n_cycles: int = 20,
-    n_discard: int = 3,
+    n_discard: int = 10,
     t_max: float | None = None,
     seed: int = 0,
     initial: str | NBlockState = "relaxed",
@@ -732,15 +739,70 @@ def sigma_deterministic_steady(model: Model, velocity: float) -> float:
     return model.f_th - bracket - 0.5 * zbar * (model.k0 + model.k1)
 
 
-def sigma_fast_limit(model: Model) -> float:
-    r"""The :math:`V \to \infty` stationary stress for any g: :math:`f_{th} - \kappa \langle z^2\rangle / (2\langle z\rangle)`.
+def sigma_deterministic_steady_finite_n(model: Model, velocity: float, n_blocks: int) -> float:
+    r"""Eq. (4) for N blocks: the exact time-averaged stress of the evenly spaced steady state.
 
-    Dashpots are frozen and every :math:`\delta_i` is a renewal process that decreases at
-    speed :math:`\kappa V` and jumps by :math:`\kappa z`; its mean is the mean residual.
-    Eq. (6) is the deterministic case (:math:`\kappa \bar z / 2`).
+    With deterministic jumps and phases spaced by :math:`\bar z / N`, the blocks jump one at
+    a time, in turn, every :math:`\Delta = \bar z/(N V)`. Just before a jump
+    :math:`\bar h - h_i = y_b = \frac{\bar z}{2}(1 - \frac1N)` and, between its own jumps,
+    block i sees the staircase :math:`\bar h - h_i = y_b - j\,\bar z/N` (j steps before its
+    next jump). Solving Eq. (2) for the periodic :math:`u_i` with :math:`q = e^{-\gamma\Delta}`,
+
+    .. math::
+        \sigma_b &= f_{th} - (k_0+k_1)\, y_b - k_2 \frac{\bar z}{N}
+                    \frac{q\,(1 - N q^{N-1} + (N-1) q^N)}{(1-q)(1-q^N)}, \\
+        \langle\sigma\rangle &= \sigma_b - \frac{k_0 \bar z}{2N},
+
+    which tends to Eq. (4) as :math:`N \to \infty`. Derived in ``docs/micro_nblock.md``.
     """
     _check_model(model)
-    return model.f_th - model.kappa * model.jumps.mean_residual
+    v = _check_float("velocity", velocity, low=0.0, strict=True)
+    n = _check_int("n_blocks", n_blocks, 2, 2**62)
+    zbar, k0, k1, k2 = model.jumps.mean, model.k0, model.k1, model.k2
+    q = math.exp(-model.gamma * zbar / (n * v))
+    y_b = 0.5 * zbar * (1.0 - 1.0 / n)
+    if q == 1.0:  # k2 = 0: no dashpot
+        lag = 0.0
+    else:
+        qn1 = q ** (n - 1)
+        lag = (zbar / n) * q * (1.0 - n * qn1 + (n - 1) * qn1 * q) / ((1.0 - q) * (1.0 - qn1 * q))
+    sigma_before = model.f_th - (k0 + k1) * y_b - k2 * lag
+    return sigma_before - 0.5 * k0 * zbar / n
+
+
+def _residual_variance(dist: JumpDistribution, n_grid: int = 400_001) -> float:
+    r"""Variance of the equilibrium residual R (density :math:`(1 - G(r))/\langle z\rangle`),
+    :math:`\langle z^3\rangle/(3\langle z\rangle) - (\langle z^2\rangle/(2\langle z\rangle))^2`, by the midpoint rule."""
+    edges = np.linspace(0.0, float(dist.z_max), n_grid)
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    weight = (1.0 - np.asarray(dist.cdf(mid), dtype=float)) * np.diff(edges)
+    total = weight.sum()
+    mean = float(np.sum(weight * mid) / total)
+    second = float(np.sum(weight * mid * mid) / total)
+    return second - mean * mean
+
+
+def sigma_fast_limit(model: Model, velocity: float | None = None) -> float:
+    r"""The large-V stationary stress for any g.
+
+    .. math:: \sigma(V) = f_{th} - \kappa \frac{\langle z^2\rangle}{2\langle z\rangle}
+              + \frac{k_2 \gamma}{V} \operatorname{Var}(R) + O(V^{-2})
+
+    At :math:`V \to \infty` dashpots are frozen and every :math:`\delta_i` is a renewal
+    process that decreases at speed :math:`\kappa V` and jumps by :math:`\kappa z`; its
+    mean is :math:`\kappa` times the mean residual. Eq. (6) is the deterministic case
+    (:math:`\kappa \bar z / 2`). With ``velocity`` the first correction is added: the
+    dashpot slows the decrease of :math:`\delta` by :math:`k_2\gamma(\langle R\rangle - R)`,
+    which reweights the residual R (whose variance is :math:`\bar z^2/12` for deterministic
+    g, reproducing the large-V expansion of Eq. (4), and :math:`\approx \bar z^2` for
+    exponential g). Valid for :math:`V \gg \gamma \bar z`.
+    """
+    _check_model(model)
+    sigma = model.f_th - model.kappa * model.jumps.mean_residual
+    if velocity is not None:
+        v = _check_float("velocity", velocity, low=0.0, strict=True)
+        sigma += model.k2 * model.gamma * _residual_variance(model.jumps) / v
+    return sigma
 
 
 def sigma_slow_limit(model: Model, velocity: float = 0.0) -> float:
