@@ -72,6 +72,13 @@ REBASE_THETA = 20.0  # rebase x when gamma (t - t_ref) reaches this (x >= 2e-9)
 SWAP_TIE = 1e-12  # relative tolerance under which two lines are considered equal now
 NO_CERT = -1.0
 
+# ---- columns of the tree array (one row per node, so that a node is one half cache line) --
+T_A = 0  # a of the node's winner
+T_B = 1  # b of the node's winner
+T_XC = 2  # certificate: x at which the node's comparison flips (NO_CERT: never)
+T_MXC = 3  # largest certificate in the node's subtree
+N_TREE_COLS = 4
+
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
 _M2 = np.uint64(0x94D049BB133111EB)
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
@@ -157,11 +164,11 @@ def first_crossing(alpha, beta, gamma, drive, tau_max):
 
 # ---- kinetic tournament tree -------------------------------------------------------------
 @njit(cache=True, inline="always")
-def tree_recompute(v, win, wa, wb, xc, mxc, x):
+def tree_recompute(v, win, tree, x):
     """Recompute internal node v from its two children at the current x.
 
-    The winner is the line a + b x lower now; the certificate xc[v] is the x (< now) at
-    which the loser overtakes it, or NO_CERT if it never does (x only decreases). Lines
+    The winner is the line a + b x lower now; the certificate tree[v, T_XC] is the x (< now)
+    at which the loser overtakes it, or NO_CERT if it never does (x only decreases). Lines
     within SWAP_TIE of each other are treated as equal now and the one lower in the
     future (larger b) wins, so that a swap is never scheduled at the present x.
     """
@@ -172,84 +179,88 @@ def tree_recompute(v, win, wa, wb, xc, mxc, x):
     if ir < 0 or il < 0:
         src = left if ir < 0 else right
         win[v] = win[src]
-        wa[v] = wa[src]
-        wb[v] = wb[src]
-        xc[v] = NO_CERT
+        tree[v, T_A] = tree[src, T_A]
+        tree[v, T_B] = tree[src, T_B]
+        tree[v, T_XC] = NO_CERT
     else:
-        tl = wa[left] + wb[left] * x
-        tr = wa[right] + wb[right] * x
-        if tl <= tr:
-            w, o = left, right
+        al = tree[left, T_A]
+        bl = tree[left, T_B]
+        ar = tree[right, T_A]
+        br = tree[right, T_B]
+        if al + bl * x <= ar + br * x:
+            w, aw, bw, ao, bo = left, al, bl, ar, br
         else:
-            w, o = right, left
+            w, aw, bw, ao, bo = right, ar, br, al, bl
         cert = NO_CERT
-        if wb[w] < wb[o]:
-            xs = (wa[w] - wa[o]) / (wb[o] - wb[w])
+        if bw < bo:
+            xs = (aw - ao) / (bo - bw)
             if xs >= x * (1.0 - SWAP_TIE):
-                w, o = o, w  # equal now: take the one that stays lower
+                # equal now: take the one that stays lower
+                w = right if w == left else left
+                aw, bw = ao, bo
             else:
                 cert = xs
         win[v] = win[w]
-        wa[v] = wa[w]
-        wb[v] = wb[w]
-        xc[v] = cert
-    m = xc[v]
-    if mxc[left] > m:
-        m = mxc[left]
-    if mxc[right] > m:
-        m = mxc[right]
-    mxc[v] = m
+        tree[v, T_A] = aw
+        tree[v, T_B] = bw
+        tree[v, T_XC] = cert
+    m = tree[v, T_XC]
+    if tree[left, T_MXC] > m:
+        m = tree[left, T_MXC]
+    if tree[right, T_MXC] > m:
+        m = tree[right, T_MXC]
+    tree[v, T_MXC] = m
 
 
 @njit(cache=True, inline="always")
-def tree_set_leaf(i, a_i, b_i, n_leaves, win, wa, wb, xc, mxc, x):
+def tree_set_leaf(i, a_i, b_i, n_leaves, win, tree, x):
     """Give block i the line a_i + b_i x and repair the path to the root."""
     v = n_leaves + i
-    wa[v] = a_i
-    wb[v] = b_i
+    tree[v, T_A] = a_i
+    tree[v, T_B] = b_i
     v >>= 1
     while v >= 1:
-        tree_recompute(v, win, wa, wb, xc, mxc, x)
+        tree_recompute(v, win, tree, x)
         v >>= 1
 
 
 @njit(cache=True)
-def tree_build(h, s_coef, par, n_leaves, win, wa, wb, xc, mxc, x):
+def tree_build(h, s_coef, par, n_leaves, win, tree, x):
     """Fill the leaves with the blocks' lines and build every internal node at x."""
     n = h.shape[0]
     k01 = par[P_K0] + par[P_K1]
     k2 = par[P_K2]
     for v in range(n_leaves, 2 * n_leaves):
         i = v - n_leaves
-        xc[v] = NO_CERT
-        mxc[v] = NO_CERT
+        tree[v, T_XC] = NO_CERT
+        tree[v, T_MXC] = NO_CERT
         if i < n:
             win[v] = i
-            wa[v] = k01 * h[i]
-            wb[v] = k2 * s_coef[i]
+            tree[v, T_A] = k01 * h[i]
+            tree[v, T_B] = k2 * s_coef[i]
         else:
             win[v] = -1
-            wa[v] = np.inf
-            wb[v] = 0.0
+            tree[v, T_A] = np.inf
+            tree[v, T_B] = 0.0
     for v in range(n_leaves - 1, 0, -1):
-        tree_recompute(v, win, wa, wb, xc, mxc, x)
+        tree_recompute(v, win, tree, x)
 
 
 @njit(cache=True)
-def tree_process_swaps(win, wa, wb, xc, mxc, x, n_leaves):
-    """Repair every node whose certificate has failed (xc >= x), deepest first."""
+def tree_process_swaps(win, tree, x, n_leaves):
+    """Repair every node whose certificate has failed (certificate >= x), deepest first."""
     count = 0
-    while mxc[1] >= x:
+    while tree[1, T_MXC] >= x:
         v = 1
         while v < n_leaves:
-            if mxc[2 * v] >= x:
+            if tree[2 * v, T_MXC] >= x:
                 v = 2 * v
-            elif mxc[2 * v + 1] >= x:
+            elif tree[2 * v + 1, T_MXC] >= x:
                 v = 2 * v + 1
             else:
                 break
         while v >= 1:
-            tree_recompute(v, win, wa, wb, xc, mxc, x)
+            tree_recompute(v, win, tree, x)
             v >>= 1
         count += 1
     return count
@@ -276,14 +287,15 @@ def advance(fs, par, velocity, t_new):
     integral = k0 * (fs[F_W] - fs[F_HBAR]) * dt + 0.5 * k0 * velocity * dt * dt
     fs[F_W] += velocity * dt
     if gamma > 0.0:
-        fs[F_M] = fs[F_HBAR] + (fs[F_M] - fs[F_HBAR]) * math.exp(-gamma * dt)
+        decay = math.exp(-gamma * dt)
+        fs[F_M] = fs[F_HBAR] + (fs[F_M] - fs[F_HBAR]) * decay
+        fs[F_X] *= decay  # reset to exactly 1 at every rebase
     fs[F_T] = t_new
-    fs[F_X] = math.exp(-gamma * (t_new - fs[F_TREF]))
     return integral
 
 
 @njit(cache=True)
-def rebase(fs, par, h, s_coef, n_leaves, win, wa, wb, xc, mxc):
+def rebase(fs, par, h, s_coef, n_leaves, win, tree):
     """Reset x to 1 and move the origin of positions to hbar (O(N), rare).
 
     S_i -> S_i x keeps every s_i; shifting h, w, hbar and m together keeps every delta.
@@ -306,12 +318,12 @@ def rebase(fs, par, h, s_coef, n_leaves, win, wa, wb, xc, mxc):
     fs[F_SUMS] = total_s
     fs[F_TREF] = fs[F_T]
     fs[F_X] = 1.0
-    tree_build(h, s_coef, par, n_leaves, win, wa, wb, xc, mxc, 1.0)
+    tree_build(h, s_coef, par, n_leaves, win, tree, 1.0)
 
 
 @njit(cache=True, inline="always")
 def avalanche(
-    trigger, fs, par, h, s_coef, n_jumps, seed, qtab_u, qtab_z, n_leaves, win, wa, wb, xc, mxc, max_jumps, counters
+    trigger, fs, par, h, s_coef, n_jumps, seed, qtab_u, qtab_z, n_leaves, win, tree, max_jumps, counters
 ):
     """Instantaneous avalanche at the current time, started by block ``trigger``.
 
@@ -335,14 +347,14 @@ def avalanche(
         s_coef[i] += dz
         fs[F_SUMS] += dz
         fs[F_HBAR] += z * inv_n
-        tree_set_leaf(i, k01 * h[i], k2 * s_coef[i], n_leaves, win, wa, wb, xc, mxc, x)
+        tree_set_leaf(i, k01 * h[i], k2 * s_coef[i], n_leaves, win, tree, x)
         size += 1
         total_z += z
         counters[C_JUMPS] += 1
         if counters[C_JUMPS] >= max_jumps:
             break
         i = win[1]
-        if wa[1] + wb[1] * x - phi(fs, par) > 0.0:
+        if tree[1, T_A] + tree[1, T_B] * x - phi(fs, par) > 0.0:
             break
     return size, total_z
 
@@ -361,10 +373,7 @@ def run_events(
     qtab_z,
     n_leaves,
     win,
-    wa,
-    wb,
-    xc,
-    mxc,
+    tree,
     seg_end,
     seg_velocity,
     bin_width,
@@ -429,20 +438,20 @@ def run_events(
             t_bin = t_max
         t_seg = seg_end[seg]
         if abs(fs[F_HBAR]) > par[P_POSBOUND]:
-            rebase(fs, par, h, s_coef, n_leaves, win, wa, wb, xc, mxc)
+            rebase(fs, par, h, s_coef, n_leaves, win, tree)
             counters[C_REBASES] += 1
         t_rebase = np.inf
         t_cert = np.inf
         if gamma > 0.0:
             t_rebase = fs[F_TREF] + REBASE_THETA / gamma
-            if mxc[1] > 0.0:
-                t_cert = fs[F_TREF] - math.log(mxc[1]) / gamma
+            if tree[1, T_MXC] > 0.0:
+                t_cert = fs[F_TREF] - math.log(tree[1, T_MXC]) / gamma
                 if t_cert < t:
                     t_cert = t
         t_lim = min(t_bin, t_seg, t_rebase, t_cert)
         x = fs[F_X]
-        alpha = wa[1] - k0 * fs[F_W] - k1 * fs[F_HBAR] + f_th
-        beta = wb[1] * x + k2 * (fs[F_M] - fs[F_HBAR])
+        alpha = tree[1, T_A] - k0 * fs[F_W] - k1 * fs[F_HBAR] + f_th
+        beta = tree[1, T_B] * x + k2 * (fs[F_M] - fs[F_HBAR])
         tau = first_crossing(alpha, beta, gamma, k0 * velocity, t_lim - t)
         if tau >= 0.0:
             t_new = t + tau
@@ -454,7 +463,7 @@ def run_events(
                 sig_max = sigma_before
             size, total_z = avalanche(
                 win[1], fs, par, h, s_coef, n_jumps, seed, qtab_u, qtab_z,
-                n_leaves, win, wa, wb, xc, mxc, max_jumps, counters,
+                n_leaves, win, tree, max_jumps, counters,
             )
             sigma_after = k0 * (fs[F_W] - fs[F_HBAR])
             if sigma_after < sig_min:
@@ -490,11 +499,11 @@ def run_events(
         else:
             integral += advance(fs, par, velocity, t_lim)
             if t_lim == t_cert:
-                if fs[F_X] > mxc[1]:
-                    fs[F_X] = mxc[1]
-                counters[C_SWAPS] += tree_process_swaps(win, wa, wb, xc, mxc, fs[F_X], n_leaves)
+                if fs[F_X] > tree[1, T_MXC]:
+                    fs[F_X] = tree[1, T_MXC]
+                counters[C_SWAPS] += tree_process_swaps(win, tree, fs[F_X], n_leaves)
             if t_lim == t_rebase:
-                rebase(fs, par, h, s_coef, n_leaves, win, wa, wb, xc, mxc)
+                rebase(fs, par, h, s_coef, n_leaves, win, tree)
                 counters[C_REBASES] += 1
             if t_lim == t_seg and seg < n_seg - 1:
                 seg += 1

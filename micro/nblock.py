@@ -414,11 +414,8 @@ def simulate_nblock(
     n_jumps = np.zeros(n, dtype=np.int64)
     n_leaves = 1 << int(math.ceil(math.log2(n)))
     win = np.empty(2 * n_leaves, dtype=np.int64)
-    wa = np.empty(2 * n_leaves)
-    wb = np.empty(2 * n_leaves)
-    xc = np.empty(2 * n_leaves)
-    mxc = np.empty(2 * n_leaves)
-    K.tree_build(h, s_coef, par, n_leaves, win, wa, wb, xc, mxc, 1.0)
+    tree = np.empty((2 * n_leaves, K.N_TREE_COLS))
+    K.tree_build(h, s_coef, par, n_leaves, win, tree, 1.0)
 
     out = {name: np.zeros(n_bins) for name in ("t", "w", "sigma", "sigma_mean", "sigma_max", "sigma_min", "mean_u")}
     out_int = {name: np.zeros(n_bins, dtype=np.int64) for name in ("n_jumps", "n_avalanches", "max_avalanche")}
@@ -434,7 +431,7 @@ def simulate_nblock(
     start = time.perf_counter()
     K.run_events(
         par, fs, counters, h, s_coef, n_jumps, np.uint64(seed), qtab_u, qtab_z,
-        n_leaves, win, wa, wb, xc, mxc, seg_end, seg_vel, record_every, n_bins, t_max,
+        n_leaves, win, tree, seg_end, seg_vel, record_every, n_bins, t_max,
         out["t"], out["w"], out["sigma"], out["sigma_mean"], out["sigma_max"], out["sigma_min"],
         out_int["n_jumps"], out_int["n_avalanches"], out_int["max_avalanche"], out["mean_u"],
         shock_min_size, stop_shocks, shock_t, shock_sb, shock_sa, shock_size, shock_dh,

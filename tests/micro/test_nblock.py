@@ -93,21 +93,21 @@ def test_kinetic_tree_tracks_the_lowest_line(rng):
     a = rng.uniform(0.0, 1.0, n)
     b = rng.uniform(-1.0, 1.0, n)
     win = np.empty(2 * n_leaves, dtype=np.int64)
-    wa, wb, xc, mxc = (np.empty(2 * n_leaves) for _ in range(4))
+    tree = np.empty((2 * n_leaves, K.N_TREE_COLS))
     par = np.zeros(K.N_PARAMS)
     par[K.P_K0], par[K.P_K1], par[K.P_K2] = 1.0, 0.0, 1.0  # so that a = h and b = S
-    K.tree_build(a, b, par, n_leaves, win, wa, wb, xc, mxc, 1.0)
+    K.tree_build(a, b, par, n_leaves, win, tree, 1.0)
     swaps = 0
     for x in np.geomspace(1.0, 1e-3, 400)[1:]:
-        swaps += K.tree_process_swaps(win, wa, wb, xc, mxc, x, n_leaves)
+        swaps += K.tree_process_swaps(win, tree, x, n_leaves)
         values = a + b * x
         assert values[win[1]] == pytest.approx(values.min(), abs=1e-12)
-        assert mxc[1] < x
+        assert tree[1, K.T_MXC] < x
         if rng.random() < 0.3:  # a jump: one block gets a new line
             i = int(rng.integers(n))
             a[i] += rng.uniform(0.0, 0.5)
             b[i] += rng.uniform(-0.5, 0.5) / x
-            K.tree_set_leaf(i, a[i], b[i], n_leaves, win, wa, wb, xc, mxc, x)
+            K.tree_set_leaf(i, a[i], b[i], n_leaves, win, tree, x)
             assert (a + b * x)[win[1]] == pytest.approx((a + b * x).min(), abs=1e-12)
     assert swaps > 20
 
