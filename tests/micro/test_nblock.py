@@ -149,6 +149,17 @@ def test_kernel_matches_reference_through_swaps_and_rebases():
     assert res.sigma_integral == pytest.approx(ref["sigma_integral"], abs=1e-9)
 
 
+@pytest.mark.parametrize("k1,k2", [(0.1, 0.0), (0.0, 0.9)])
+@pytest.mark.parametrize("velocity", [1.0, 0.0, [(1.0, 0.5), (2.0, 0.0)]])
+def test_kernel_matches_reference_at_k1_or_k2_zero_and_holds(k1, k2, velocity):
+    model = Model(k0=0.3, k1=k1, k2=k2, jumps=Exponential(0.1))
+    ref = nb.reference_simulate(model, velocity, 30, t_max=3.0, seed=2, phases="random")
+    res = nb.simulate_nblock(model, velocity, 30, t_max=3.0, seed=2, phases="random")
+    assert res.n_jumps == ref["n_jumps"]
+    np.testing.assert_allclose(res.final_state.h, ref["state"].h, atol=1e-11)
+    np.testing.assert_allclose(res.final_state.u, ref["state"].u, atol=1e-11)
+
+
 # ----------------------------------------------------------------------------------------
 # invariants
 # ----------------------------------------------------------------------------------------
