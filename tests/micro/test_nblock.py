@@ -7,6 +7,8 @@ and against exact invariants; never against saved output. Long runs are marked s
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -398,3 +400,15 @@ def test_slow_stick_slip_extrema_converge_in_n():
     for attr in ("sigma_max", "sigma_min"):
         err = getattr(small, attr + "_stderr") + getattr(large, attr + "_stderr")
         assert abs(getattr(small, attr) - getattr(large, attr)) < 5.0 * err + 2e-3
+
+
+def test_docs_example_runs():
+    """The example at the top of docs/micro_nblock.md runs as written."""
+    text = (Path(__file__).resolve().parents[2] / "docs" / "micro_nblock.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    assert blocks
+    for code in blocks:
+        namespace: dict = {}
+        exec(compile(code, "docs/micro_nblock.md", "exec"), namespace)
+    assert namespace["cycle"].regime == "stick-slip"
+    assert namespace["steady"].sigma_stderr > 0.0
