@@ -1,0 +1,934 @@
+r"""An independent check of the Fokker-Planck solver: the mean-field N-block model itself.
+
+N blocks at positions :math:`h_i` with dashpot elongations :math:`u_i` follow the mean-field
+limit of Eqs. (1)-(2) of Landes, Rosso & Jagla (2015) in the narrow-wells approximation
+with instantaneous avalanches (:math:`\tau_0 \to 0`):
+
+.. math::
+    \eta_0 \partial_t h_i &= k_0 (w - h_i) + (k_1 + k_2)(\bar h - h_i) - k_2 u_i + f_i^{dis}(h_i) \\
+    \eta_u \partial_t u_i &= k_2 (\bar h - h_i) - k_2 u_i, \qquad \sigma = k_0 (w - \bar h) \quad (3)
+
+A block is pinned while :math:`\delta_i = f_{th} - k_0(w - h_i) - (k_1+k_2)(\bar h - h_i) + k_2 u_i > 0`
+(Eq. (B1)); when :math:`\delta_i \le 0` it jumps to its next well, :math:`h_i \to h_i + z`
+with z drawn from :math:`g(z)`, and :math:`u_i` does not change. Between jumps the
+:math:`u_i` relax in closed form (Eq. (B3)).
+
+The simulation is event driven and exact up to round-off: there is no time step. See
+``docs/micro_nblock.md`` for the derivations (jump and redistribution increments, the
+O(log N) lazy representation, the analytic limits used by the tests).
+
+This module shares nothing with the Fokker-Planck solver but :mod:`micro.params`.
+
+Entry points
+------------
+:func:`simulate_nblock`
+    one run under a constant drive velocity or a piecewise-constant schedule.
+:func:`stationary_stress_nblock`
+    the stationary stress with a batch-means standard error.
+:func:`stick_slip_extrema_nblock`
+    :math:`\sigma_{max}`, :math:`\sigma_{min}` of the stick-slip cycle with standard errors.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import numbers
+import time
+from dataclasses import dataclass, field
+from typing import Sequence, Union
+
+import numpy as np
+import pandas as pd
+
+from micro import _nblock_kernels as K
+from micro.params import Deterministic, Exponential, JumpDistribution, Model, Tabulated
+
+__all__ = [
+    "NBlockState",
+    "NBlockResult",
+    "StationaryStress",
+    "StickSlipExtrema",
+    "initial_state",
+    "simulate_nblock",
+    "stationary_stress_nblock",
+    "stick_slip_extrema_nblock",
+    "sigma_deterministic_steady",
+    "sigma_deterministic_steady_finite_n",
+    "sigma_fast_limit",
+    "sigma_slow_limit",
+    "reference_simulate",
+]
+
+logger = logging.getLogger(__name__)
+
+Schedule = Sequence[tuple[float, float]]
+Velocity = Union[float, Schedule]
+
+#: The largest number of blocks (block indices and tree nodes are 64-bit, memory is the limit).
+MAX_BLOCKS = 2**27
+#: The largest number of output bins of one run.
+MAX_BINS = 50_000_000
+_SIZE_HIST_BINS = 64
+
+STATUS_MESSAGES = {
+    K.STATUS_COMPLETED: ("completed", "reached t_max"),
+    K.STATUS_SHOCK_LIMIT: ("shock_limit", "stopped after the requested number of global shocks"),
+    K.STATUS_JUMP_LIMIT: ("jump_limit", "stopped at max_jumps before t_max"),
+}
+
+
+# ---------------------------------------------------------------------------------------
+# validation
+# ---------------------------------------------------------------------------------------
+def _check_model(model: Model) -> None:
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be a micro.params.Model, got {type(model).__name__}")
+
+
+def _check_int(name: str, value, low: int, high: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
+        raise ValueError(f"{name} must be an integer in [{low}, {high}], got {value!r}")
+    value = int(value)
+    if not low <= value <= high:
+        raise ValueError(f"{name} must be an integer in [{low}, {high}], got {value!r}")
+    return value
+
+
+def _check_float(name: str, value, *, low: float = -math.inf, strict: bool = False, allow_none: bool = False):
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
+        raise ValueError(f"{name} must be a finite number {'>' if strict else '>='} {low}, got {value!r}")
+    value = float(value)
+    ok = math.isfinite(value) and (value > low if strict else value >= low)
+    if not ok:
+        raise ValueError(f"{name} must be a finite number {'>' if strict else '>='} {low}, got {value!r}")
+    return value
+
+
+def _segments(velocity: Velocity, t_max: float | None) -> tuple[np.ndarray, np.ndarray, float]:
+    """Turn a velocity or a schedule [(duration, velocity), ...] into segment end times.
+
+    With a schedule and no t_max, the run lasts the schedule's total duration; with a
+    shorter t_max the schedule is cut; with a longer one the last velocity is held.
+    """
+    if isinstance(velocity, (numbers.Real, np.floating, np.integer)) and not isinstance(velocity, bool):
+        v = _check_float("velocity", velocity, low=0.0)
+        if t_max is None:
+            raise ValueError("t_max must be given (a finite number > 0) with a constant velocity")
+        t_max = _check_float("t_max", t_max, low=0.0, strict=True)
+        return np.array([t_max]), np.array([v]), t_max
+    try:
+        items = list(velocity)  # type: ignore[arg-type]
+    except TypeError:
+        raise ValueError(
+            "velocity must be a finite number >= 0 or a schedule [(duration, velocity), ...], "
+            f"got {velocity!r}"
+        ) from None
+    if len(items) == 0:
+        raise ValueError("velocity schedule must hold at least one (duration, velocity) pair")
+    ends, vels = [], []
+    total = 0.0
+    for k, item in enumerate(items):
+        try:
+            duration, v = item
+        except (TypeError, ValueError):
+            raise ValueError(f"velocity schedule entry {k} must be a (duration, velocity) pair, got {item!r}") from None
+        duration = _check_float(f"velocity schedule entry {k} duration", duration, low=0.0, strict=True)
+        v = _check_float(f"velocity schedule entry {k} velocity", v, low=0.0)
+        total += duration
+        ends.append(total)
+        vels.append(v)
+    if t_max is None:
+        t_max = total
+    t_max = _check_float("t_max", t_max, low=0.0, strict=True)
+    seg_end = np.minimum(np.array(ends), t_max)
+    keep = np.concatenate([[True], seg_end[1:] > seg_end[:-1]]) & (np.concatenate([[0.0], seg_end[:-1]]) < t_max)
+    seg_end, seg_vel = seg_end[keep], np.array(vels)[keep]
+    seg_end[-1] = t_max
+    return seg_end, seg_vel, t_max
+
+
+# ---------------------------------------------------------------------------------------
+# the pinning-distance distribution, as the kernels need it
+# ---------------------------------------------------------------------------------------
+def _jump_tables(dist: JumpDistribution) -> tuple[int, float, float, np.ndarray, np.ndarray]:
+    """(kind, zbar, norm, u-knots, z-knots) for :func:`micro._nblock_kernels.draw_distance`.
+
+    Exponential and deterministic distances are drawn in closed form (the same inverse
+    cumulative distribution as :meth:`Exponential.quantile`). A :class:`Tabulated`
+    distribution is drawn by interpolating its own cumulative distribution at its own nodes,
+    which reproduces :meth:`Tabulated.quantile`; any other distribution through a dense
+    table of its quantile function.
+    """
+    dummy = np.zeros(2)
+    if isinstance(dist, Exponential):
+        return K.KIND_EXPONENTIAL, float(dist.zbar), float(-math.expm1(-dist.cutoff / dist.zbar)), dummy, dummy
+    if isinstance(dist, Deterministic):
+        return K.KIND_DETERMINISTIC, float(dist.zbar), 1.0, dummy, dummy
+    if isinstance(dist, Tabulated):
+        z = np.linspace(0.0, float(dist.support_max), int(dist.n))
+        u = np.asarray(dist.cdf(z), dtype=float)
+        keep = np.concatenate([[True], np.diff(u) > 0.0])
+        return K.KIND_TABLE, float(dist.mean), 1.0, np.ascontiguousarray(u[keep]), np.ascontiguousarray(z[keep])
+    u = np.linspace(0.0, 1.0, 2**16 + 1)
+    z = np.minimum(np.asarray(dist.quantile(u), dtype=float), float(dist.z_max))
+    return K.KIND_TABLE, float(dist.mean), 1.0, u, z
+
+
+def _residual_quantile(dist: JumpDistribution, q: np.ndarray, n_grid: int = 200_001) -> np.ndarray:
+    r"""Quantiles of the equilibrium residual of a renewal process with increments z ~ g.
+
+    Its density is :math:`(1 - G(r)) / \langle z\rangle` (G the cumulative distribution);
+    tabulated by the midpoint rule on [0, z_max], which is exact for deterministic g.
+    """
+    edges = np.linspace(0.0, float(dist.z_max), n_grid)
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    survival = 1.0 - np.asarray(dist.cdf(mid), dtype=float)
+    cum = np.concatenate([[0.0], np.cumsum(survival * np.diff(edges))])
+    cum /= cum[-1]
+    keep = np.concatenate([[True], np.diff(cum) > 0.0])
+    return np.interp(q, cum[keep], edges[keep])
+
+
+# ---------------------------------------------------------------------------------------
+# states and results
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class NBlockState:
+    """Positions ``h``, dashpot elongations ``u`` and drive position ``w`` at time ``t``."""
+
+    h: np.ndarray
+    u: np.ndarray
+    w: float
+    t: float = 0.0
+
+    @property
+    def hbar(self) -> float:
+        return float(np.mean(self.h))
+
+    def sigma(self, model: Model) -> float:
+        """The stress, Eq. (3)."""
+        return model.k0 * (self.w - self.hbar)
+
+    def delta(self, model: Model) -> np.ndarray:
+        """The stability margins, Eq. (B1)."""
+        hbar = self.hbar
+        return (
+            model.f_th
+            - model.k0 * (self.w - self.h)
+            - (model.k1 + model.k2) * (hbar - self.h)
+            + model.k2 * self.u
+        )
+
+
+def initial_state(
+    model: Model,
+    n_blocks: int,
+    kind: str = "relaxed",
+    phases: str = "stratified",
+    seed: int = 0,
+) -> NBlockState:
+    r"""An initial state whose margins are an equilibrium renewal residual.
+
+    Every block gets :math:`h_i = r_i`, with :math:`r_i` a quantile of the equilibrium
+    residual of a renewal process with increments z ~ g (density
+    :math:`(1-G(r))/\langle z\rangle`), and :math:`\bar h` is the sample mean.
+
+    ``kind="relaxed"``
+        :math:`u_i = \bar h - h_i` (dashpots relaxed) and w set so that
+        :math:`\delta_i = (k_0+k_1) r_i`: the quasi-static state (V -> 0, k0 > k2).
+    ``kind="frozen"``
+        :math:`u_i = 0` and w set so that :math:`\delta_i = (k_0+k_1+k_2) r_i`: the
+        :math:`V \to \infty` state (dashpots have no time to relax).
+
+    ``phases="stratified"`` takes the quantiles :math:`(i + 1/2)/N` (for deterministic g:
+    evenly spaced phases, the steady state of Appendix C); ``phases="random"`` draws them
+    independently (seeded by ``seed``). Both have :math:`\langle u_i\rangle = 0`.
+    The paper notes that the initial condition only affects transients.
+    """
+    _check_model(model)
+    n = _check_int("n_blocks", n_blocks, 2, MAX_BLOCKS)
+    if phases == "stratified":
+        q = (np.arange(n) + 0.5) / n
+    elif phases == "random":
+        q = np.random.default_rng(_check_int("seed", seed, 0, 2**63 - 1)).random(n)
+    else:
+        raise ValueError(f"phases must be 'stratified' or 'random', got {phases!r}")
+    r = _residual_quantile(model.jumps, q)
+    h = r.copy()
+    hbar = float(np.mean(h))
+    if kind == "relaxed":
+        u = hbar - h
+        stiffness = model.k0 + model.k1
+    elif kind == "frozen":
+        u = np.zeros(n)
+        stiffness = model.kappa
+    else:
+        raise ValueError(f"initial kind must be 'relaxed' or 'frozen', got {kind!r}")
+    # delta_i = f_th - sigma0 + stiffness (h_i - hbar) = stiffness r_i
+    sigma0 = model.f_th - stiffness * hbar
+    w = hbar + sigma0 / model.k0
+    return NBlockState(h=h, u=u, w=w, t=0.0)
+
+
+@dataclass
+class NBlockResult:
+    """The outcome of :func:`simulate_nblock`.
+
+    Attributes
+    ----------
+    timeseries : one row per output bin (width ``record_every``): ``t`` (bin end), ``w``
+        and ``sigma`` at ``t``, ``sigma_mean`` (exact time average of sigma over the bin),
+        ``sigma_max`` / ``sigma_min`` over the bin, ``n_jumps``, ``n_avalanches``,
+        ``max_avalanche`` (in jumps) and ``mean_u`` at ``t``.
+    shocks : one row per global shock (an avalanche of at least ``shock_min_size`` jumps):
+        ``t``, ``sigma_before``, ``sigma_after``, ``size`` (jumps), ``delta_hbar``.
+    status : ``"completed"``, ``"shock_limit"`` or ``"jump_limit"``; ``message`` says why.
+    final_state : the state at the end, positions in absolute coordinates.
+    avalanche_size_histogram : counts of avalanche sizes s in [2^b, 2^(b+1)), b = 0..63.
+    """
+
+    timeseries: pd.DataFrame
+    shocks: pd.DataFrame
+    status: str
+    message: str
+    n_blocks: int
+    n_jumps: int
+    n_avalanches: int
+    n_swaps: int
+    n_rebases: int
+    n_shocks_lost: int
+    shock_min_size: int
+    avalanche_size_histogram: np.ndarray
+    final_state: NBlockState
+    sigma_integral: float
+    wall_time: float
+    model: Model
+    seed: int
+    schedule: tuple[tuple[float, float], ...] = field(default=())
+
+    @property
+    def success(self) -> bool:
+        return self.status in ("completed", "shock_limit")
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The time series ``t, w, sigma, ...`` as a pandas DataFrame."""
+        return self.timeseries.copy()
+
+
+# ---------------------------------------------------------------------------------------
+# the simulation
+# ---------------------------------------------------------------------------------------
+def simulate_nblock(
+    model: Model,
+    velocity: Velocity,
+    n_blocks: int,
+    t_max: float | None = None,
+    seed: int = 0,
+    record_every: float | None = None,
+    initial: str | NBlockState = "relaxed",
+    phases: str = "stratified",
+    shock_fraction: float = 0.25,
+    stop_after_shocks: int | None = None,
+    max_jumps: int | None = None,
+) -> NBlockResult:
+    r"""Simulate the mean-field N-block model, event by event.
+
+    Parameters
+    ----------
+    model : the parameters (:class:`micro.params.Model`).
+    velocity : the drive velocity V >= 0 (then ``w = w_0 + V t``), or a schedule
+        ``[(duration, velocity), ...]`` of piecewise-constant velocities (0 for a hold).
+    n_blocks : the number of blocks N, an integer >= 2.
+    t_max : the end time; required with a constant velocity; with a schedule it defaults to
+        the schedule's duration (a shorter t_max cuts it, a longer one holds its last velocity).
+    seed : fixes the pinning landscape: the k-th well distance of block i is a hash of
+        (seed, i, k), so the run is reproducible and avalanches are order independent.
+    record_every : output bin width (default ``t_max / 1000``).
+    initial : ``"relaxed"`` or ``"frozen"`` (see :func:`initial_state`) or an explicit
+        :class:`NBlockState` (its ``t`` is ignored: runs start at t = 0).
+    phases : ``"stratified"`` or ``"random"`` initial residuals (see :func:`initial_state`).
+    shock_fraction : an avalanche of at least ``ceil(shock_fraction * N)`` jumps is recorded
+        as a global shock.
+    stop_after_shocks : stop right after this many global shocks (default: never).
+    max_jumps : stop after this many jumps (default: never); the status then says so.
+
+    Returns
+    -------
+    NBlockResult
+
+    Notes
+    -----
+    Exact event-driven dynamics: between events, :math:`\bar h` is constant and every
+    :math:`\delta_i(t) = \alpha_i + \beta_i e^{-\gamma (t-t_0)} - k_0 V (t-t_0)` in closed form
+    (Eq. (B3)); the next instability is the root of this function for the least stable block,
+    which a kinetic tournament tree maintains in O(log N) per jump. An avalanche is processed
+    at frozen time, least stable block first, until every :math:`\delta_i > 0`.
+    """
+    _check_model(model)
+    n = _check_int("n_blocks", n_blocks, 2, MAX_BLOCKS)
+    seed = _check_int("seed", seed, 0, 2**64 - 1)
+    seg_end, seg_vel, t_max = _segments(velocity, t_max)
+    if record_every is None:
+        record_every = t_max / 1000.0
+    record_every = _check_float("record_every", record_every, low=0.0, strict=True)
+    n_bins = int(math.ceil(t_max / record_every - 1e-9))
+    n_bins = max(n_bins, 1)
+    if n_bins > MAX_BINS:
+        raise ValueError(f"record_every must be >= t_max / {MAX_BINS} = {t_max / MAX_BINS!r}, got {record_every!r}")
+    shock_fraction = _check_float("shock_fraction", shock_fraction, low=0.0, strict=True)
+    shock_min_size = max(1, int(math.ceil(shock_fraction * n)))
+    stop_shocks = 2**62 if stop_after_shocks is None else _check_int("stop_after_shocks", stop_after_shocks, 1, 2**62)
+    max_jumps_int = 2**62 if max_jumps is None else _check_int("max_jumps", max_jumps, 1, 2**62)
+
+    if isinstance(initial, NBlockState):
+        h0 = np.asarray(initial.h, dtype=float)
+        u0 = np.asarray(initial.u, dtype=float)
+        if h0.shape != (n,) or u0.shape != (n,):
+            raise ValueError(f"initial state arrays h and u must have shape ({n},), got {h0.shape} and {u0.shape}")
+        if not (np.all(np.isfinite(h0)) and np.all(np.isfinite(u0)) and math.isfinite(float(initial.w))):
+            raise ValueError("initial state h, u and w must be finite")
+        state0 = NBlockState(h=h0.copy(), u=u0.copy(), w=float(initial.w))
+    elif isinstance(initial, str):
+        state0 = initial_state(model, n, kind=initial, phases=phases, seed=seed % (2**63))
+    else:
+        raise ValueError(f"initial must be 'relaxed', 'frozen' or an NBlockState, got {initial!r}")
+
+    kind, zbar, norm, qtab_u, qtab_z = _jump_tables(model.jumps)
+    par = np.zeros(K.N_PARAMS)
+    par[K.P_K0], par[K.P_K1], par[K.P_K2] = model.k0, model.k1, model.k2
+    par[K.P_GAMMA], par[K.P_FTH], par[K.P_INVN] = model.gamma, model.f_th, 1.0 / n
+    par[K.P_KIND], par[K.P_ZBAR], par[K.P_NORM] = kind, zbar, norm
+    par[K.P_POSBOUND] = 1e3 * max(float(model.jumps.mean), 1e-300)
+
+    # lazy state: s_i = u_i + h_i = m + x S_i with m = hbar and x = 1 at t = 0
+    h = state0.h.copy()
+    hbar = float(np.mean(h))
+    s_coef = h + state0.u - hbar
+    fs = np.zeros(K.N_FSTATE)
+    fs[K.F_T], fs[K.F_TREF], fs[K.F_X] = 0.0, 0.0, 1.0
+    fs[K.F_W], fs[K.F_HBAR], fs[K.F_M] = state0.w, hbar, hbar
+    fs[K.F_SUMS] = float(np.sum(s_coef))
+    counters = np.zeros(K.N_COUNTERS, dtype=np.int64)
+    n_jumps = np.zeros(n, dtype=np.int64)
+    n_leaves = 1 << int(math.ceil(math.log2(n)))
+    win = np.empty(2 * n_leaves, dtype=np.int64)
+    tree = np.empty((2 * n_leaves, K.N_TREE_COLS))
+    K.tree_build(h, s_coef, par, n_leaves, win, tree, 1.0)
+
+    out = {name: np.zeros(n_bins) for name in ("t", "w", "sigma", "sigma_mean", "sigma_max", "sigma_min", "mean_u")}
+    out_int = {name: np.zeros(n_bins, dtype=np.int64) for name in ("n_jumps", "n_avalanches", "max_avalanche")}
+    n_shock_slots = int(min(stop_shocks, 1_000_000))
+    shock_t = np.zeros(n_shock_slots)
+    shock_sb = np.zeros(n_shock_slots)
+    shock_sa = np.zeros(n_shock_slots)
+    shock_size = np.zeros(n_shock_slots, dtype=np.int64)
+    shock_dh = np.zeros(n_shock_slots)
+    size_hist = np.zeros(_SIZE_HIST_BINS, dtype=np.int64)
+
+    logger.info("N-block run: N=%d, t_max=%g, %d segment(s), seed=%d", n, t_max, len(seg_end), seed)
+    start = time.perf_counter()
+    K.run_events(
+        par, fs, counters, h, s_coef, n_jumps, np.uint64(seed), qtab_u, qtab_z,
+        n_leaves, win, tree, seg_end, seg_vel, record_every, n_bins, t_max,
+        out["t"], out["w"], out["sigma"], out["sigma_mean"], out["sigma_max"], out["sigma_min"],
+        out_int["n_jumps"], out_int["n_avalanches"], out_int["max_avalanche"], out["mean_u"],
+        shock_min_size, stop_shocks, shock_t, shock_sb, shock_sa, shock_size, shock_dh,
+        size_hist, max_jumps_int,
+    )
+    wall = time.perf_counter() - start
+    filled = int(counters[K.C_BINS])
+    n_shocks = int(counters[K.C_SHOCKS])
+    status, message = STATUS_MESSAGES[int(counters[K.C_STATUS])]
+    if counters[K.C_SHOCKS_LOST] > 0:
+        message += f"; {int(counters[K.C_SHOCKS_LOST])} global shocks beyond the first {n_shock_slots} were not recorded"
+    timeseries = pd.DataFrame({**{k: v[:filled] for k, v in out.items()}, **{k: v[:filled] for k, v in out_int.items()}})
+    timeseries = timeseries[
+        ["t", "w", "sigma", "sigma_mean", "sigma_max", "sigma_min", "n_jumps", "n_avalanches", "max_avalanche", "mean_u"]
+    ]
+    shocks = pd.DataFrame(
+        {
+            "t": shock_t[:n_shocks],
+            "sigma_before": shock_sb[:n_shocks],
+            "sigma_after": shock_sa[:n_shocks],
+            "size": shock_size[:n_shocks],
+            "delta_hbar": shock_dh[:n_shocks],
+        }
+    )
+    offset = fs[K.F_OFFSET]
+    x = fs[K.F_X]
+    u_final = fs[K.F_M] + x * s_coef - h
+    final = NBlockState(h=h + offset, u=u_final, w=float(fs[K.F_W] + offset), t=float(fs[K.F_T]))
+    sigma_integral = float(np.sum(timeseries["sigma_mean"].to_numpy() * np.diff(np.concatenate([[0.0], timeseries["t"].to_numpy()]))))
+    logger.info(
+        "N-block run done in %.3g s: %d jumps, %d avalanches, %d tree swaps, status %s",
+        wall, counters[K.C_JUMPS], counters[K.C_AVALANCHES], counters[K.C_SWAPS], status,
+    )
+    return NBlockResult(
+        timeseries=timeseries,
+        shocks=shocks,
+        status=status,
+        message=message,
+        n_blocks=n,
+        n_jumps=int(counters[K.C_JUMPS]),
+        n_avalanches=int(counters[K.C_AVALANCHES]),
+        n_swaps=int(counters[K.C_SWAPS]),
+        n_rebases=int(counters[K.C_REBASES]),
+        n_shocks_lost=int(counters[K.C_SHOCKS_LOST]),
+        shock_min_size=shock_min_size,
+        avalanche_size_histogram=size_hist,
+        final_state=final,
+        sigma_integral=sigma_integral,
+        wall_time=wall,
+        model=model,
+        seed=seed,
+        schedule=tuple(zip(np.diff(np.concatenate([[0.0], seg_end])).tolist(), seg_vel.tolist())),
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# what a comparison needs: stationary stress and stick-slip extrema, with errors
+# ---------------------------------------------------------------------------------------
+@dataclass
+class StationaryStress:
+    r"""The stationary stress of a steady-sliding run, by batch means.
+
+    ``sigma_mean`` is the mean of ``n_batches`` exact time averages of sigma over
+    consecutive windows of length ``batch_length`` after a discarded transient of
+    ``t_transient``; ``sigma_stderr_naive`` their standard deviation over sqrt(n_batches),
+    and ``sigma_stderr`` the same inflated by :math:`\sqrt{(1+\rho)/(1-\rho)}` (the AR(1)
+    correction) when the lag-1 autocorrelation :math:`\rho` of the batch means is positive.
+    A large :math:`\rho` means the batches are too short. ``regime`` is ``"stick-slip"`` if global
+    shocks occurred during the measurement (the mean is then not a stationary stress).
+    """
+
+    sigma_mean: float
+    sigma_stderr: float
+    sigma_stderr_naive: float
+    batch_means: np.ndarray
+    batch_length: float
+    t_transient: float
+    lag1_autocorrelation: float
+    n_global_shocks: int
+    regime: str
+    status: str
+    message: str
+    velocity: float
+    n_blocks: int
+    wall_time: float
+    result: NBlockResult = field(repr=False)
+
+    @property
+    def n_batches(self) -> int:
+        return int(self.batch_means.size)
+
+
+def _lag1(values: np.ndarray) -> float:
+    if values.size < 3:
+        return float("nan")
+    d = values - values.mean()
+    denom = float(np.dot(d, d))
+    return float(np.dot(d[1:], d[:-1]) / denom) if denom > 0.0 else 0.0
+
+
+def stationary_stress_nblock(
+    model: Model,
+    velocity: float,
+    n_blocks: int,
+    *,
+    t_transient: float | None = None,
+    batch_length: float | None = None,
+    n_batches: int = 20,
+    seed: int = 0,
+    initial: str | NBlockState = "relaxed",
+    phases: str = "stratified",
+    shock_fraction: float = 0.25,
+    max_jumps: int | None = None,
+) -> StationaryStress:
+    r"""The stationary stress :math:`\sigma(V)` of the N-block model with its standard error.
+
+    Parameters
+    ----------
+    model, velocity, n_blocks, seed, initial, phases, shock_fraction, max_jumps :
+        as in :func:`simulate_nblock` (``velocity`` > 0 here).
+    t_transient : discarded time; default ``10 / gamma`` (ten relaxation times), or
+        ``200 zbar / V`` if k2 = 0. It is rounded up to a whole number of batches.
+    batch_length : length of one batch; default ``5 / gamma`` (or ``100 zbar / V``).
+    n_batches : number of batches, >= 2.
+
+    Returns
+    -------
+    StationaryStress
+    """
+    _check_model(model)
+    v = _check_float("velocity", velocity, low=0.0, strict=True)
+    n_batches = _check_int("n_batches", n_batches, 2, 10**7)
+    scale = 1.0 / model.gamma if model.k2 > 0.0 else 20.0 * model.jumps.mean / v
+    t_transient = _check_float("t_transient", 10.0 * scale if t_transient is None else t_transient, low=0.0)
+    batch_length = _check_float("batch_length", 5.0 * scale if batch_length is None else batch_length, low=0.0, strict=True)
+    n_skip = int(math.ceil(t_transient / batch_length - 1e-9))
+    t_max = (n_skip + n_batches) * batch_length
+    res = simulate_nblock(
+        model, v, n_blocks, t_max=t_max, seed=seed, record_every=batch_length, initial=initial,
+        phases=phases, shock_fraction=shock_fraction, max_jumps=max_jumps,
+    )
+    ts = res.timeseries
+    batches = ts["sigma_mean"].to_numpy()[n_skip:]
+    if res.status != "completed" or batches.size < 2:
+        raise RuntimeError(f"N-block run stopped early ({res.status}: {res.message}); raise max_jumps")
+    shocks = res.shocks
+    n_shocks = int(np.sum(shocks["t"].to_numpy() > n_skip * batch_length)) if len(shocks) else 0
+    regime = "stick-slip" if n_shocks >= 2 else "steady"
+    lag1 = _lag1(batches)
+    message = "stationary stress by batch means"
+    status = "ok"
+    if regime == "stick-slip":
+        status = "stick-slip"
+        message = f"{n_shocks} global shocks during the measurement: not a steady state"
+        logger.warning("stationary_stress_nblock(V=%g): %s", v, message)
+    elif lag1 > 0.3:
+        status = "correlated"
+        message = f"batch means are correlated (lag-1 autocorrelation {lag1:.2f}): use longer batches"
+        logger.warning("stationary_stress_nblock(V=%g): %s", v, message)
+    naive = float(batches.std(ddof=1) / math.sqrt(batches.size))
+    rho = min(max(lag1, 0.0), 0.9) if math.isfinite(lag1) else 0.0
+    inflation = math.sqrt((1.0 + rho) / (1.0 - rho))
+    return StationaryStress(
+        sigma_mean=float(batches.mean()),
+        sigma_stderr=naive * inflation,
+        sigma_stderr_naive=naive,
+        batch_means=batches,
+        batch_length=batch_length,
+        t_transient=n_skip * batch_length,
+        lag1_autocorrelation=lag1,
+        n_global_shocks=n_shocks,
+        regime=regime,
+        status=status,
+        message=message,
+        velocity=v,
+        n_blocks=res.n_blocks,
+        wall_time=res.wall_time,
+        result=res,
+    )
+
+
+@dataclass
+class StickSlipExtrema:
+    r"""Mean stress just before (``sigma_max``) and just after (``sigma_min``) the global shocks.
+
+    Means over ``n_cycles`` shocks after ``n_discard`` discarded ones, with standard errors
+    (standard deviation over sqrt(n_cycles)); ``period`` is the mean time between them.
+    ``regime`` is ``"steady"`` if fewer than ``n_discard + 2`` global shocks occurred by
+    ``t_max`` (then the extrema are NaN).
+    """
+
+    sigma_max: float
+    sigma_max_stderr: float
+    sigma_min: float
+    sigma_min_stderr: float
+    period: float
+    period_stderr: float
+    n_cycles: int
+    regime: str
+    status: str
+    message: str
+    velocity: float
+    n_blocks: int
+    wall_time: float
+    shocks: pd.DataFrame = field(repr=False)
+    result: NBlockResult = field(repr=False)
+
+
+def stick_slip_extrema_nblock(
+    model: Model,
+    velocity: float,
+    n_blocks: int,
+    *,
+    n_cycles: int = 20,
+    n_discard: int = 10,
+    t_max: float | None = None,
+    seed: int = 0,
+    initial: str | NBlockState = "relaxed",
+    phases: str = "stratified",
+    shock_fraction: float = 0.25,
+    record_every: float | None = None,
+    max_jumps: int | None = None,
+) -> StickSlipExtrema:
+    r"""The stick-slip extrema :math:`\sigma_{max}`, :math:`\sigma_{min}` with standard errors.
+
+    Runs until ``n_discard + n_cycles`` global shocks (avalanches of at least
+    ``shock_fraction * N`` jumps) have occurred, or until ``t_max`` (default
+    ``(n_discard + n_cycles + 1) * 2 f_th / (k0 V)``, twice the time the drive needs to load
+    the stress by f_th per cycle). The first ``n_discard`` shocks are the transient.
+    """
+    _check_model(model)
+    v = _check_float("velocity", velocity, low=0.0, strict=True)
+    n_cycles = _check_int("n_cycles", n_cycles, 2, 10**6)
+    n_discard = _check_int("n_discard", n_discard, 0, 10**6)
+    total = n_discard + n_cycles
+    if t_max is None:
+        t_max = (total + 1) * 2.0 * model.f_th / (model.k0 * v)
+    t_max = _check_float("t_max", t_max, low=0.0, strict=True)
+    if record_every is None:
+        record_every = t_max / 2000.0
+    res = simulate_nblock(
+        model, v, n_blocks, t_max=t_max, seed=seed, record_every=record_every, initial=initial,
+        phases=phases, shock_fraction=shock_fraction, stop_after_shocks=total, max_jumps=max_jumps,
+    )
+    used = res.shocks.iloc[n_discard:]
+    nan = float("nan")
+    if len(used) < 2:
+        msg = f"only {len(res.shocks)} global shocks by t = {res.final_state.t:g} ({res.status}): no stick-slip cycle"
+        logger.info("stick_slip_extrema_nblock(V=%g): %s", v, msg)
+        return StickSlipExtrema(nan, nan, nan, nan, nan, nan, int(len(used)), "steady", "no_cycles", msg,
+                                v, res.n_blocks, res.wall_time, res.shocks, res)
+    before = used["sigma_before"].to_numpy()
+    after = used["sigma_after"].to_numpy()
+    periods = np.diff(used["t"].to_numpy())
+    root = math.sqrt(len(used))
+    status = "ok" if len(used) == n_cycles else "fewer_cycles"
+    msg = f"{len(used)} cycles after {n_discard} discarded shocks"
+    if status != "ok":
+        logger.warning("stick_slip_extrema_nblock(V=%g): only %s", v, msg)
+    return StickSlipExtrema(
+        sigma_max=float(before.mean()),
+        sigma_max_stderr=float(before.std(ddof=1) / root),
+        sigma_min=float(after.mean()),
+        sigma_min_stderr=float(after.std(ddof=1) / root),
+        period=float(periods.mean()),
+        period_stderr=float(periods.std(ddof=1) / math.sqrt(len(periods))) if len(periods) > 1 else nan,
+        n_cycles=int(len(used)),
+        regime="stick-slip",
+        status=status,
+        message=msg,
+        velocity=v,
+        n_blocks=res.n_blocks,
+        wall_time=res.wall_time,
+        shocks=used.reset_index(drop=True),
+        result=res,
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# analytic results the tests compare with (derived in docs/micro_nblock.md)
+# ---------------------------------------------------------------------------------------
+def sigma_deterministic_steady(model: Model, velocity: float) -> float:
+    r"""Eq. (4): the stationary stress for deterministic jumps :math:`g(z) = \delta(z - \bar z)`.
+
+    .. math:: \sigma(V) = f_{th} - \left[V\eta_u - \frac{\bar z k_2}{e^{\bar z k_2/V\eta_u} - 1}\right]
+              - \frac{\bar z}{2}(k_0 + k_1)
+
+    It assumes steady sliding (each block jumps every :math:`\bar z / V`); it uses the mean of
+    ``model.jumps`` as :math:`\bar z` and is exact only for :class:`Deterministic` jumps.
+    """
+    _check_model(model)
+    v = _check_float("velocity", velocity, low=0.0)
+    zbar, k2, eta = model.jumps.mean, model.k2, model.eta_u
+    if v == 0.0:
+        bracket = 0.0
+    else:
+        a = zbar * k2 / (v * eta)
+        if a < 1e-6:
+            bracket = 0.5 * zbar * k2 - zbar * zbar * k2 * k2 / (12.0 * v * eta)
+        else:
+            bracket = v * eta - zbar * k2 / math.expm1(a)
+    return model.f_th - bracket - 0.5 * zbar * (model.k0 + model.k1)
+
+
+def sigma_deterministic_steady_finite_n(model: Model, velocity: float, n_blocks: int) -> float:
+    r"""Eq. (4) for N blocks: the exact time-averaged stress of the evenly spaced steady state.
+
+    With deterministic jumps and phases spaced by :math:`\bar z / N`, the blocks jump one at
+    a time, in turn, every :math:`\Delta = \bar z/(N V)`. Just before a jump
+    :math:`\bar h - h_i = y_b = \frac{\bar z}{2}(1 - \frac1N)` and, between its own jumps,
+    block i sees the staircase :math:`\bar h - h_i = y_b - j\,\bar z/N` (j steps before its
+    next jump). Solving Eq. (2) for the periodic :math:`u_i` with :math:`q = e^{-\gamma\Delta}`,
+
+    .. math::
+        \sigma_b &= f_{th} - (k_0+k_1)\, y_b - k_2 \frac{\bar z}{N}
+                    \frac{q\,(1 - N q^{N-1} + (N-1) q^N)}{(1-q)(1-q^N)}, \\
+        \langle\sigma\rangle &= \sigma_b - \frac{k_0 \bar z}{2N},
+
+    which tends to Eq. (4) as :math:`N \to \infty`. Derived in ``docs/micro_nblock.md``.
+    """
+    _check_model(model)
+    v = _check_float("velocity", velocity, low=0.0, strict=True)
+    n = _check_int("n_blocks", n_blocks, 2, 2**62)
+    zbar, k0, k1, k2 = model.jumps.mean, model.k0, model.k1, model.k2
+    q = math.exp(-model.gamma * zbar / (n * v))
+    y_b = 0.5 * zbar * (1.0 - 1.0 / n)
+    if q == 1.0:  # k2 = 0: no dashpot
+        lag = 0.0
+    else:
+        qn1 = q ** (n - 1)
+        lag = (zbar / n) * q * (1.0 - n * qn1 + (n - 1) * qn1 * q) / ((1.0 - q) * (1.0 - qn1 * q))
+    sigma_before = model.f_th - (k0 + k1) * y_b - k2 * lag
+    return sigma_before - 0.5 * k0 * zbar / n
+
+
+def _residual_variance(dist: JumpDistribution, n_grid: int = 400_001) -> float:
+    r"""Variance of the equilibrium residual R (density :math:`(1 - G(r))/\langle z\rangle`),
+    :math:`\langle z^3\rangle/(3\langle z\rangle) - (\langle z^2\rangle/(2\langle z\rangle))^2`, by the midpoint rule."""
+    edges = np.linspace(0.0, float(dist.z_max), n_grid)
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    weight = (1.0 - np.asarray(dist.cdf(mid), dtype=float)) * np.diff(edges)
+    total = weight.sum()
+    mean = float(np.sum(weight * mid) / total)
+    second = float(np.sum(weight * mid * mid) / total)
+    return second - mean * mean
+
+
+def sigma_fast_limit(model: Model, velocity: float | None = None) -> float:
+    r"""The large-V stationary stress for any g.
+
+    .. math:: \sigma(V) = f_{th} - \kappa \frac{\langle z^2\rangle}{2\langle z\rangle}
+              + \frac{k_2 \gamma}{V} \operatorname{Var}(R) + O(V^{-2})
+
+    At :math:`V \to \infty` dashpots are frozen and every :math:`\delta_i` is a renewal
+    process that decreases at speed :math:`\kappa V` and jumps by :math:`\kappa z`; its
+    mean is :math:`\kappa` times the mean residual. Eq. (6) is the deterministic case
+    (:math:`\kappa \bar z / 2`). With ``velocity`` the first correction is added: the
+    dashpot slows the decrease of :math:`\delta` by :math:`k_2\gamma(\langle R\rangle - R)`,
+    which reweights the residual R (whose variance is :math:`\bar z^2/12` for deterministic
+    g, reproducing the large-V expansion of Eq. (4), and :math:`\approx \bar z^2` for
+    exponential g). Valid for :math:`V \gg \gamma \bar z`.
+    """
+    _check_model(model)
+    sigma = model.f_th - model.kappa * model.jumps.mean_residual
+    if velocity is not None:
+        v = _check_float("velocity", velocity, low=0.0, strict=True)
+        sigma += model.k2 * model.gamma * _residual_variance(model.jumps) / v
+    return sigma
+
+
+def sigma_slow_limit(model: Model, velocity: float = 0.0) -> float:
+    r"""The small-V stationary stress for k0 > k2 (steady quasi-static sliding), any g:
+
+    .. math:: \sigma(V) = f_{th} - (k_0 + k_1)\frac{\langle z^2\rangle}{2\langle z\rangle} - \eta_u V + O(V^2)
+
+    Dashpots relax between a block's jumps, so its relaxed margin is a renewal process with
+    increments :math:`(k_0+k_1) z`; a block jumps when the common relaxed signal lags
+    :math:`\bar h` by :math:`V/\gamma`, i.e. with relaxed margin :math:`k_2 V/\gamma = \eta_u V`.
+    Eq. (5) is the deterministic case at V = 0.
+    """
+    _check_model(model)
+    v = _check_float("velocity", velocity, low=0.0)
+    return model.f_th - (model.k0 + model.k1) * model.jumps.mean_residual - model.eta_u * v
+
+
+# ---------------------------------------------------------------------------------------
+# a plain-numpy brute-force reference (O(N) per event, explicit u_i), for small N only
+# ---------------------------------------------------------------------------------------
+_U64 = np.uint64
+
+
+def _mix64_numpy(z: np.ndarray) -> np.ndarray:
+    z = (z ^ (z >> _U64(30))) * _U64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> _U64(27))) * _U64(0x94D049BB133111EB)
+    return z ^ (z >> _U64(31))
+
+
+def hash_uniform_numpy(seed: int, block: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """numpy twin of :func:`micro._nblock_kernels.hash_uniform` (the pinning landscape)."""
+    block = np.atleast_1d(np.asarray(block)).astype(np.uint64)
+    count = np.atleast_1d(np.asarray(count)).astype(np.uint64)
+    with np.errstate(over="ignore"):
+        k = _mix64_numpy(np.full(block.shape, seed, dtype=np.uint64) ^ (block * _U64(0x9E3779B97F4A7C15)))
+        k = _mix64_numpy(k + count * _U64(0xD1B54A32D192ED03))
+    return ((k >> _U64(11)).astype(float) + 0.5) / 9007199254740992.0
+
+
+def reference_simulate(
+    model: Model,
+    velocity: Velocity,
+    n_blocks: int,
+    t_max: float | None = None,
+    seed: int = 0,
+    initial: str | NBlockState = "relaxed",
+    phases: str = "stratified",
+) -> dict:
+    r"""Brute-force reference of :func:`simulate_nblock` for small N (tests only).
+
+    It keeps :math:`h_i` and :math:`u_i` explicitly, relaxes every :math:`u_i` by Eq. (B3)
+    between events, evaluates Eq. (B1) for every block, finds each block's crossing with
+    :func:`scipy.optimize.brentq`, and topples all unstable blocks of an avalanche together
+    in sweeps. Distances come from ``model.jumps.quantile`` of the same landscape hash.
+    Costs O(N) per event.
+
+    Returns a dict with ``state`` (final :class:`NBlockState`), ``n_jumps``, ``n_avalanches``,
+    ``sigma_integral`` (integral of sigma over [0, t_max]) and ``avalanches``
+    (list of (t, size)).
+    """
+    from scipy.optimize import brentq
+
+    _check_model(model)
+    n = _check_int("n_blocks", n_blocks, 2, 4096)
+    seg_end, seg_vel, t_max = _segments(velocity, t_max)
+    if isinstance(initial, NBlockState):
+        h, u, w = np.array(initial.h, dtype=float), np.array(initial.u, dtype=float), float(initial.w)
+    else:
+        st = initial_state(model, n, kind=initial, phases=phases, seed=seed % (2**63))
+        h, u, w = st.h.copy(), st.u.copy(), st.w
+    k0, k1, k2, f_th, gamma = model.k0, model.k1, model.k2, model.f_th, model.gamma
+    count = np.zeros(n, dtype=np.int64)
+    t = 0.0
+    integral = 0.0
+    n_jumps = 0
+    avalanches: list[tuple[float, int]] = []
+
+    def distances(blocks: np.ndarray) -> np.ndarray:
+        uu = hash_uniform_numpy(seed, blocks, count[blocks])
+        return np.asarray(model.jumps.quantile(uu), dtype=float)
+
+    def margins() -> np.ndarray:
+        hbar = h.mean()
+        return f_th - k0 * (w - h) - (k1 + k2) * (hbar - h) + k2 * u
+
+    seg = 0
+    while True:
+        v = seg_vel[seg]
+        tau_max = seg_end[seg] - t
+        hbar = h.mean()
+        alpha = f_th - k0 * w - k1 * hbar + (k0 + k1) * h  # relaxed margin
+        beta = k2 * (u - (hbar - h))
+        f_end = alpha + beta * math.exp(-gamma * tau_max) - k0 * v * tau_max
+        best_tau, best_i = math.inf, -1
+        for i in np.flatnonzero(f_end <= 0.0):
+            a_i, b_i = alpha[i], beta[i]
+            if a_i + b_i <= 0.0:
+                tau = 0.0
+            else:
+                tau = brentq(lambda s: a_i + b_i * math.exp(-gamma * s) - k0 * v * s, 0.0, tau_max,
+                             xtol=1e-15, rtol=8.9e-16)
+            if tau < best_tau:
+                best_tau, best_i = tau, i
+        tau = min(best_tau, tau_max)
+        # advance: drive and relax (Eq. (B3)) with hbar fixed
+        integral += k0 * (w - hbar) * tau + 0.5 * k0 * v * tau * tau
+        u = (hbar - h) + (u - (hbar - h)) * math.exp(-gamma * tau)
+        w += v * tau
+        t += tau
+        if best_i >= 0 and best_tau <= tau_max:
+            unstable = np.array([best_i])
+            size = 0
+            while unstable.size:
+                h[unstable] += distances(unstable)
+                count[unstable] += 1
+                size += unstable.size
+                unstable = np.flatnonzero(margins() <= 0.0)
+            n_jumps += size
+            avalanches.append((t, size))
+        else:
+            t = float(seg_end[seg])
+            if seg == len(seg_end) - 1:
+                break
+            seg += 1
+    state = NBlockState(h=h, u=u, w=w, t=t)
+    return {
+        "state": state,
+        "n_jumps": n_jumps,
+        "n_avalanches": len(avalanches),
+        "sigma_integral": integral,
+        "avalanches": avalanches,
+    }
