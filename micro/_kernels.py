@@ -44,18 +44,19 @@ F_SIGMA = 3  # stress k0 (w - hbar)
 F_PHI = 4  # continuous shift in bins, [0, 1)
 F_MEANX = 5  # sum of M * delta_F
 F_JUMPS = 6  # cumulative number of jumps per block
-F_PENDING = 7  # relaxation time not applied yet (Strang splitting)
+F_PENDING = 7  # time not relaxed yet (negative: relaxed ahead, see advance)
 F_SLIP_RATE = 8  # d hbar / dt over the last step
 F_DISP = 9  # mass-weighted mean |delta_R_inf - delta_R| (sets the relaxation step)
 F_NEG = 10  # most negative cell mass seen (stays 0)
 F_MASS = 11  # total mass (diagnostic)
-F_WIN_START = 12  # start of the current record window
+F_WIN_START = 12  # time of the last record (start of the current window)
 F_WIN_MIN = 13  # smallest stress in the window
 F_WIN_MAX = 14  # largest stress in the window
 F_WIN_INT = 15  # time integral of the stress over the window
 F_WIN_LEN = 16  # time covered by F_WIN_INT
 F_OWED = 17  # shift (bins) owed but not applied yet (|owed| <= OWED_TOL, or an iteration cap)
-N_FSTATE = 18
+F_REC_SIGMA = 18  # stress at the last record
+N_FSTATE = 19
 
 # --- integer state -----------------------------------------------------------------
 I_OFF = 0  # column of d = 0
@@ -86,7 +87,8 @@ P_THETA_S = 12  # largest shift per step, in bins
 P_THETA_R = 13  # largest typical relaxation displacement per step, in bins
 P_DT_MAX = 14  # largest time step
 P_SHOCK = 15  # closure shift (bins) above which a step is recorded as a shock
-N_PARAM = 16
+P_REC_DSIGMA = 16  # record when the stress has moved this much since the last record
+N_PARAM = 17
 
 # --- return codes ---------------------------------------------------------------------
 DONE = 0
@@ -97,10 +99,14 @@ SHOCKS_FULL = 4
 MAX_STEPS = 5
 STOP_EVENT = 6
 
+#: An injection stops once the mass left in its tail is below this; the rest goes into
+#: its last cell (mass stays exact, the tail beyond is not resolved).
+TAIL_FLOOR = 1e-16
 #: Cell edges within this many bins of the threshold count as on it.
 EDGE_TOL = 1e-9
-#: Owed shifts below this many bins are settled.
-OWED_TOL = 1e-13
+#: The closure stops once less than this many bins are owed; the remainder is carried
+#: exactly to the next step.
+OWED_TOL = 1e-2
 
 
 @njit(cache=True, inline="always")
@@ -161,10 +167,23 @@ def inject_row(M, W, O, r, jbase, off, phi, eps, mass, eta, depth, prm, table, c
     first = c
     f_lo = f_cut
     moment = 0.0
+    exponential = int(prm[P_KIND]) == 0
+    if exponential:
+        # F(s) = (1 - exp(-s/b)) / norm for s < s_max: one multiplication per bin
+        b = prm[P_D0]
+        s_max = prm[P_D1]
+        norm = prm[P_D2]
+        s_hi = (d + 1 + theta) * eps
+        e_hi = math.exp(-s_hi / b)
+        ratio = math.exp(-eps / b)
     while True:
-        if c >= ncol - 1:
-            c = ncol - 1  # fold the far tail into the last column (conserves mass)
+        if c >= ncol - 1 or (1.0 - f_lo) * scale < TAIL_FLOOR:
+            c = min(c, ncol - 1)  # fold the far tail into this column (conserves mass)
             f_hi = 1.0
+        elif exponential:
+            f_hi = (1.0 - e_hi) / norm if s_hi < s_max else 1.0
+            e_hi *= ratio
+            s_hi += eps
         else:
             f_hi = landing_cdf((d + 1 + theta) * eps, prm, table)
         dm = (f_hi - f_lo) * scale
@@ -187,15 +206,14 @@ def inject_row(M, W, O, r, jbase, off, phi, eps, mass, eta, depth, prm, table, c
 
 
 @njit(cache=True)
-def threshold_scan(M, W, O, off, phi, rlo, rhi):
-    """Exit rate and linear range at the stability boundary.
+def threshold_rate(M, W, O, off, phi, rlo, rhi):
+    """Mass that crosses ``delta = 0`` per bin of shift, from the cells touching it.
 
-    Returns ``(rate, room)``: ``rate`` is the mass that crosses ``delta = 0`` per bin of
-    shift while no cell starts or stops crossing, and ``room`` (in bins, at most
-    ``1 - phi``) is how far the shift can go before one does.
+    A cell whose mass sits in ``[lo, hi)`` (in bins) with ``lo`` within ``EDGE_TOL`` of
+    the threshold loses ``M / omega`` per bin; mass already below the threshold (left by
+    a merge) counts as crossing at once.
     """
     rate = 0.0
-    room = 1.0 - phi
     for r in range(rlo, rhi):
         for d in range(-1, 2):
             c = off + d
@@ -203,20 +221,10 @@ def threshold_scan(M, W, O, off, phi, rlo, rhi):
             if m <= 0.0:
                 continue
             omega = O[r, c] / m
-            hi = d + 1 - phi + W[r, c] / m
-            lo = hi - omega
-            if lo > EDGE_TOL:
-                if lo < room:
-                    room = lo
-            elif lo < -EDGE_TOL or omega <= EDGE_TOL:
-                room = 0.0  # mass below threshold (left by merging): let it jump at once
-            else:
+            lo = d + 1 - phi + W[r, c] / m - omega
+            if lo <= EDGE_TOL and omega > EDGE_TOL:
                 rate += m / omega
-                if omega < room:
-                    room = omega
-    if room < 0.0:
-        room = 0.0
-    return rate, room
+    return rate
 
 
 @njit(cache=True)
@@ -306,12 +314,17 @@ def _apply_jumps(fst, prm, jumped, moment):
 
 @njit(cache=True)
 def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_w, ex_d, max_iter):
-    """Apply ``owed`` bins of shift and the redistribution it triggers, self-consistently.
+    """Apply ``owed`` bins of shift and the stress redistribution it triggers.
 
-    Within the range where no cell starts or stops crossing, the crossing mass is linear
-    in the shift, so the closure ``shift = owed + c * shift`` (``c`` = redistribution per
-    bin of shift) is solved in one go; an avalanche (``c >= 1``) proceeds edge by edge.
-    Returns the total shift in bins and the number of iterations.
+    With ``c`` the redistribution (in bins) per bin of shift from the cells touching the
+    threshold, the closure ``shift = owed + c * shift`` gives ``shift = owed / (1 - c)``;
+    the exits of that shift are then computed exactly cell by cell, and what the linear
+    prediction missed (cells that start or stop crossing within the shift) is owed
+    again.  An avalanche (``c >= 1``) applies what it owes, at most up to the next column
+    boundary, and goes on.  A small negative remainder (the prediction overshot) is
+    carried to the next step rather than dropped, so that
+    ``sum(M * delta_F) + sigma - owed * eps`` stays exactly constant.  Returns the total
+    shift in bins and the number of iterations.
     """
     eps = prm[P_EPS]
     c_per_mass = (prm[P_K1] + prm[P_K2]) * prm[P_ZMEAN] / eps
@@ -319,19 +332,16 @@ def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_w, ex_d, 
     it = 0
     while owed > OWED_TOL and it < max_iter:
         it += 1
-        rate, room = threshold_scan(M, W, O, ist[I_OFF], fst[F_PHI], ist[I_RLO], ist[I_RHI])
-        c = c_per_mass * rate
-        if c < 1.0:
-            step = min(owed / (1.0 - c), room)
-        else:
+        c = c_per_mass * threshold_rate(M, W, O, ist[I_OFF], fst[F_PHI], ist[I_RLO], ist[I_RHI])
+        step = owed / (1.0 - c) if c < 1.0 else owed
+        room = 1.0 - fst[F_PHI]
+        if step > room:
             step = room
         jumped, moment = shift_and_jump(M, W, O, ist, fst, prm, table, chi, clo, step, ex_m, ex_w, ex_d)
         total += step
         owed -= step
         if jumped > 0.0:
             owed += _apply_jumps(fst, prm, jumped, moment)
-    # a small negative remainder (the linear closure overshot) is carried, not dropped,
-    # so that sum(M * delta_F) + sigma - owed * eps stays exactly constant
     fst[F_OWED] = owed
     return total, it
 
@@ -466,20 +476,41 @@ def relax(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_n, dt,
 
 
 @njit(cache=True)
+def _record(rec, ist, fst, t, sigma):
+    """Write one record (the window since the previous record) and open a new window."""
+    n = ist[I_NREC]
+    rec[n, 0] = t
+    rec[n, 1] = sigma
+    rec[n, 2] = min(fst[F_WIN_MIN], sigma)
+    rec[n, 3] = max(fst[F_WIN_MAX], sigma)
+    rec[n, 4] = fst[F_WIN_INT] / fst[F_WIN_LEN] if fst[F_WIN_LEN] > 0.0 else sigma
+    ist[I_NREC] = n + 1
+    fst[F_WIN_START] = t
+    fst[F_REC_SIGMA] = sigma
+    fst[F_WIN_MIN] = sigma
+    fst[F_WIN_MAX] = sigma
+    fst[F_WIN_INT] = 0.0
+    fst[F_WIN_LEN] = 0.0
+
+
+@njit(cache=True)
 def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, ex_d,
             velocity, t_stop, max_steps, cols_needed, rec, rec_dt, shocks, stop_shocks):
     """Advance the density from ``fst[F_T]`` to ``t_stop`` at drive velocity ``velocity``.
 
-    One step: relax for the pending half step plus half of this one (Strang splitting),
-    drive by ``velocity * dt``, and close the cascade of shifts, jumps and stress
-    redistribution.  The step is the largest that keeps the shift within ``P_THETA_S``
-    bins and the typical relaxation within ``P_THETA_R`` bins, and does not pass
-    ``t_stop`` or a record boundary.
+    One step: drive by ``velocity * dt`` and close the cascade of shifts, jumps and
+    stress redistribution it triggers; relax the dashpots (Eq. B3) for the time elapsed
+    since the last relaxation whenever the typical displacement that has accumulated
+    reaches ``P_THETA_R`` bins (a lazy Lie splitting: relaxation is exact in time, so
+    applying it less often only delays it).  The step keeps the shift within
+    ``P_THETA_S`` bins and does not pass ``t_stop``.
 
-    Every ``rec_dt`` it records ``t, sigma, min sigma, max sigma, time-mean sigma`` over
-    the window.  A step whose cascade shifts more than ``P_SHOCK`` bins is a shock,
-    recorded as ``t, sigma before, sigma after, shift in bins``.  Returns a code telling
-    why it stopped; on ``NEED_ROWS`` and ``NEED_COLS`` the state is untouched.
+    Records ``t, sigma, min sigma, max sigma, time-mean sigma`` (over the window since
+    the previous record) whenever the stress has moved by ``P_REC_DSIGMA`` since the last
+    record, ``rec_dt`` has passed, or a shock happens (then one record just before it and
+    one just after).  A step whose cascade shifts more than ``P_SHOCK`` bins is a shock,
+    also listed as ``t, sigma before, sigma after, shift in bins``.  Returns a code
+    telling why it stopped; on ``NEED_ROWS`` and ``NEED_COLS`` the state is untouched.
     """
     k0 = prm[P_K0]
     eps = prm[P_EPS]
@@ -502,36 +533,46 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, 
         if shift_rate > 0.0:
             dt = min(dt, prm[P_THETA_S] / shift_rate)
         relax_rate = gamma * fst[F_DISP] / eps
-        if relax_rate > 0.0:
-            dt = min(dt, prm[P_THETA_R] / relax_rate)
-        win_end = fst[F_WIN_START] + rec_dt
+        if relax_rate > 0.0 and 0.5 * prm[P_THETA_R] / relax_rate > fst[F_PENDING]:
+            dt = min(dt, 0.5 * prm[P_THETA_R] / relax_rate - fst[F_PENDING])
         dt = min(dt, t_stop - t)
-        if win_end > t:
-            dt = min(dt, win_end - t)
-        # --- relaxation over half of the previous step and half of this one
-        tau = fst[F_PENDING] + 0.5 * dt
-        lam = math.exp(-gamma * tau)
+        # --- relaxation, lazily and centred in time: an event relaxes for the time since
+        # the previous event's midpoint plus half the interval to the next one (the same
+        # as this one), so that the relaxation events sit at the centres of the intervals
+        # they stand for (second-order splitting).  An interval is as long as it takes the
+        # typical displacement to reach P_THETA_R bins.
         a = ist[I_CUR]
-        rmin, rmax, cmax = bounds_after_relax(ist, fst, prm, lam, bufclo[a], bufchi[a])
-        if rmin < 1 or rmax > nrow - 2:
-            return NEED_ROWS
-        if cmax > ncol - 2:
-            return NEED_COLS
-        b = 1 - a
-        for r in range(nrow):
-            bufchi[b, r] = 0
-            bufclo[b, r] = ncol
-        jumped, moment = relax(bufM[a], bufW[a], bufO[a], bufM[b], bufW[b], bufO[b], ist, fst, prm, table,
-                               bufchi[a], bufclo[a], bufchi[b], bufclo[b], tau, ex_m, ex_w, ex_d)
-        ist[I_CUR] = b
-        M = bufM[b]
-        W = bufW[b]
-        O = bufO[b]
-        chi = bufchi[b]
-        clo = bufclo[b]
         owed = fst[F_OWED]
-        if jumped > 0.0:
-            owed += _apply_jumps(fst, prm, jumped, moment)
+        tau = fst[F_PENDING] + dt
+        relax_rate = gamma * fst[F_DISP] / eps
+        interval = prm[P_THETA_R] / relax_rate if relax_rate > 0.0 else 0.0
+        end = t + dt >= t_stop * (1.0 - 1e-15)
+        if gamma > 0.0 and (tau >= 0.5 * interval * (1.0 - 1e-12) or end):
+            ahead = 0.0 if end else 0.5 * interval
+            lam = math.exp(-gamma * (tau + ahead))
+            rmin, rmax, cmax = bounds_after_relax(ist, fst, prm, lam, bufclo[a], bufchi[a])
+            if rmin < 1 or rmax > nrow - 2:
+                return NEED_ROWS
+            if cmax > ncol - 2:
+                return NEED_COLS
+            b = 1 - a
+            for r in range(nrow):
+                bufchi[b, r] = 0
+                bufclo[b, r] = ncol
+            jumped, moment = relax(bufM[a], bufW[a], bufO[a], bufM[b], bufW[b], bufO[b], ist, fst, prm, table,
+                                   bufchi[a], bufclo[a], bufchi[b], bufclo[b], tau + ahead, ex_m, ex_w, ex_d)
+            ist[I_CUR] = b
+            a = b
+            fst[F_PENDING] = -ahead
+            if jumped > 0.0:
+                owed += _apply_jumps(fst, prm, jumped, moment)
+        else:
+            fst[F_PENDING] = tau
+        M = bufM[a]
+        W = bufW[a]
+        O = bufO[a]
+        chi = bufchi[a]
+        clo = bufclo[a]
         # --- drive, then the cascade it triggers
         sigma_prev = fst[F_SIGMA]
         hbar_prev = fst[F_HBAR]
@@ -542,22 +583,18 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, 
         sigma_before = fst[F_SIGMA]
         total, it = close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_w, ex_d, 100000000)
         ist[I_ITER] += it
-        fst[F_PENDING] = 0.5 * dt
         fst[F_SLIP_RATE] = (fst[F_HBAR] - hbar_prev) / dt
         steps += 1
         ist[I_STEPS] += 1
         sigma_after = fst[F_SIGMA]
         # --- records.  The state after the cascade is the accurate one (within a step the
         # drive is applied before the jumps it causes, a splitting sawtooth): averages and
-        # minima use post-cascade values; the value before the cascade counts only as the
+        # extrema use post-cascade values; the value before the cascade counts only as the
         # peak before a shock.
-        fst[F_WIN_INT] += 0.5 * (sigma_prev + sigma_after) * dt
-        fst[F_WIN_LEN] += dt
-        fst[F_WIN_MIN] = min(fst[F_WIN_MIN], sigma_after)
-        fst[F_WIN_MAX] = max(fst[F_WIN_MAX], sigma_after)
-        if total > prm[P_SHOCK]:
+        shock = total > prm[P_SHOCK]
+        if shock:
             fst[F_WIN_MAX] = max(fst[F_WIN_MAX], sigma_before)
-        if total > prm[P_SHOCK]:
+            _record(rec, ist, fst, fst[F_T], sigma_before)
             n = ist[I_NSHOCK]
             if n < shocks.shape[0]:
                 shocks[n, 0] = fst[F_T]
@@ -565,22 +602,16 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, 
                 shocks[n, 2] = sigma_after
                 shocks[n, 3] = total
             ist[I_NSHOCK] = n + 1
-        if fst[F_T] >= win_end - 1e-14 * max(1.0, abs(win_end)):
-            n = ist[I_NREC]
-            if n < rec.shape[0]:
-                rec[n, 0] = fst[F_T]
-                rec[n, 1] = sigma_after
-                rec[n, 2] = fst[F_WIN_MIN]
-                rec[n, 3] = fst[F_WIN_MAX]
-                rec[n, 4] = fst[F_WIN_INT] / fst[F_WIN_LEN] if fst[F_WIN_LEN] > 0.0 else sigma_after
-            ist[I_NREC] = n + 1
-            fst[F_WIN_START] = fst[F_T]
-            fst[F_WIN_MIN] = sigma_after
-            fst[F_WIN_MAX] = sigma_after
-            fst[F_WIN_INT] = 0.0
-            fst[F_WIN_LEN] = 0.0
-            if n + 1 >= rec.shape[0]:
-                return RECORDS_FULL
+        else:
+            fst[F_WIN_INT] += 0.5 * (sigma_prev + sigma_after) * dt
+            fst[F_WIN_LEN] += dt
+        fst[F_WIN_MIN] = min(fst[F_WIN_MIN], sigma_after)
+        fst[F_WIN_MAX] = max(fst[F_WIN_MAX], sigma_after)
+        if (shock or abs(sigma_after - fst[F_REC_SIGMA]) >= prm[P_REC_DSIGMA]
+                or fst[F_T] - fst[F_WIN_START] >= rec_dt or fst[F_T] >= t_stop * (1.0 - 1e-15)):
+            _record(rec, ist, fst, fst[F_T], sigma_after)
+        if ist[I_NREC] + 2 >= rec.shape[0]:
+            return RECORDS_FULL
         if ist[I_NSHOCK] >= shocks.shape[0]:
             return SHOCKS_FULL
         if stop_shocks > 0 and ist[I_NSHOCK] >= stop_shocks:

@@ -20,7 +20,7 @@ __all__ = ["Grid", "GridSettings"]
 log = logging.getLogger(__name__)
 
 #: Mass of the jump-length distribution left beyond the grid's last column.
-TAIL_MASS = 1e-14
+TAIL_MASS = 1e-12
 
 
 @dataclass(frozen=True)
@@ -33,7 +33,7 @@ class GridSettings:
         ``eps <= kappa * zbar / 4``.
     theta_shift : largest shift of delta_F per time step, in bins (0 < theta_shift <= 1).
     theta_relax : largest typical relaxation of delta_R per time step, in bins.
-    dt_max : largest time step.
+    dt_max : largest time step (may be infinite).
     """
 
     eps: float = 2e-3
@@ -42,10 +42,12 @@ class GridSettings:
     dt_max: float = 1.0
 
     def __post_init__(self) -> None:
-        for name in ("eps", "theta_shift", "theta_relax", "dt_max"):
+        for name in ("eps", "theta_shift", "theta_relax"):
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v > 0.0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        if not float(self.dt_max) > 0.0:
+            raise ValueError(f"dt_max must be > 0, got {self.dt_max!r}")
         if self.theta_shift > 1.0:
             raise ValueError(f"theta_shift must be in (0, 1], got {self.theta_shift!r}")
 
@@ -187,6 +189,7 @@ class Grid:
         fst[K.F_DISP] = float(np.sum(weight * np.abs(model.k2 / model.kappa * (mean_x - (k + 0.5) * eps) - y)))
         fst[K.F_WIN_MIN] = fst[K.F_SIGMA]
         fst[K.F_WIN_MAX] = fst[K.F_SIGMA]
+        fst[K.F_REC_SIGMA] = fst[K.F_SIGMA]
 
     # ----------------------------------------------------------------------------- state
     @property
@@ -294,30 +297,40 @@ class Grid:
         self.ist[K.I_OFF] += col_shift
 
     # ----------------------------------------------------------------------------- stepping
+    def copy(self) -> "Grid":
+        """An independent copy of the grid and its state (to branch a protocol)."""
+        new = object.__new__(Grid)
+        new.__dict__.update(self.__dict__)
+        for name in ("bufM", "bufW", "bufO", "bufchi", "bufclo", "ex_m", "ex_w", "ex_d", "ist", "fst", "prm"):
+            setattr(new, name, getattr(self, name).copy())
+        return new
+
     def advance(
         self,
         velocity: float,
         t_stop: float,
-        record_interval: float,
         *,
+        record_dsigma: float,
+        record_dt: float,
         stop_after_shocks: int = 0,
         shock_bins: float = 8.0,
         max_steps: int = 1 << 62,
     ) -> tuple[np.ndarray, np.ndarray, int]:
         """Advance to ``t_stop`` at constant drive velocity.
 
-        Returns ``(records, shocks, code)``: records are rows ``t, sigma, min, max, mean``
-        per ``record_interval``; shocks are rows ``t, sigma_before, sigma_after, shift``
-        for every step whose cascade shifted more than ``shock_bins`` bins.
+        Records (rows ``t, sigma, min, max, mean`` over the window since the previous
+        record) are written whenever the stress has moved by ``record_dsigma``, after at
+        most ``record_dt``, and just before and after every shock.  Shocks (rows
+        ``t, sigma_before, sigma_after, shift``) are the steps whose cascade shifted delta_F
+        by more than ``shock_bins`` bins.  Returns ``(records, shocks, code)``.
         """
         self.prm[K.P_SHOCK] = shock_bins
+        self.prm[K.P_REC_DSIGMA] = record_dsigma
         records: list[np.ndarray] = []
         shocks: list[np.ndarray] = []
-        rec = np.zeros((4096, 5))
+        rec = np.zeros((8192, 5))
         shk = np.zeros((1024, 4))
         seen_shocks = 0
-        if self.fst[K.F_WIN_START] + record_interval <= self.fst[K.F_T]:
-            self.fst[K.F_WIN_START] = self.fst[K.F_T]
         while True:
             self.ist[K.I_NREC] = 0
             self.ist[K.I_NSHOCK] = 0
@@ -325,9 +338,9 @@ class Grid:
             code = K.advance(
                 self.bufM, self.bufW, self.bufO, self.bufchi, self.bufclo, self.ist, self.fst, self.prm,
                 self.table, self.ex_m, self.ex_w, self.ex_d, float(velocity), float(t_stop), max_steps,
-                self.cols_needed, rec, float(record_interval), shk, remaining_shocks,
+                self.cols_needed, rec, float(record_dt), shk, remaining_shocks,
             )
-            n_rec = min(int(self.ist[K.I_NREC]), rec.shape[0])
+            n_rec = int(self.ist[K.I_NREC])
             n_shk = min(int(self.ist[K.I_NSHOCK]), shk.shape[0])
             if n_rec:
                 records.append(rec[:n_rec].copy())

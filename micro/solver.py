@@ -1,0 +1,528 @@
+"""Orchestration of the Fokker-Planck solver: protocol runs, stationary states, the
+critical velocity, sweeps and slide-hold-slide.
+
+``simulate`` runs a driving protocol and returns the stress time series.
+``stationary`` drives at constant V until the requested quantity has converged (a
+steady stress, or the extrema of a stick-slip cycle) and stops there.
+``critical_velocity`` bisects on the regime, as in the paper's Appendix B.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+
+from . import _kernels as K
+from .analysis import Records, cycle_converged, find_cycles
+from .grid import Grid, GridSettings
+from .params import Model
+from .protocols import Drive
+
+__all__ = [
+    "Numerics",
+    "Convergence",
+    "Run",
+    "Stationary",
+    "Critical",
+    "default_eps",
+    "sigma_infinity",
+    "simulate",
+    "stationary",
+    "critical_velocity",
+    "sweep",
+    "slide_hold_slide",
+]
+
+log = logging.getLogger(__name__)
+
+#: Default bin: this fraction of a mean jump of delta, kappa * zbar.
+EPS_FRACTION = 1.0 / 50.0
+
+
+def default_eps(model: Model) -> float:
+    """The default bin, ``kappa * zbar / 50`` (2e-3 for the paper's parameters)."""
+    return model.kappa * model.zbar * EPS_FRACTION
+
+
+def sigma_infinity(model: Model) -> float:
+    r"""Stationary stress for :math:`V \to \infty`: dashpots frozen, each delta renews with
+    increments :math:`\kappa z`, so :math:`\sigma = f_{th} - \kappa\langle z^2\rangle / (2\langle z\rangle)`
+    (Eq. (6) for deterministic jumps; :math:`f_{th} - \kappa\bar z` for exponential ones)."""
+    return model.f_th - model.kappa * model.jumps.mean_residual
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """Discretisation: bin ``eps`` (default :func:`default_eps`) and the step limits."""
+
+    eps: float | None = None
+    theta_shift: float = 0.5
+    theta_relax: float = 0.5
+
+    def __post_init__(self) -> None:
+        if self.eps is not None and not (math.isfinite(self.eps) and self.eps > 0.0):
+            raise ValueError(f"eps must be a finite number > 0 (or None for the default), got {self.eps!r}")
+        if not (0.0 < self.theta_shift <= 1.0):
+            raise ValueError(f"theta_shift must be in (0, 1], got {self.theta_shift!r}")
+        if not (math.isfinite(self.theta_relax) and self.theta_relax > 0.0):
+            raise ValueError(f"theta_relax must be a finite number > 0, got {self.theta_relax!r}")
+
+    def settings(self, model: Model) -> GridSettings:
+        eps = default_eps(model) if self.eps is None else float(self.eps)
+        settings = GridSettings(eps=eps, theta_shift=self.theta_shift, theta_relax=self.theta_relax, dt_max=math.inf)
+        settings.check(model)
+        return settings
+
+
+@dataclass(frozen=True)
+class Convergence:
+    """When a stationary run stops.
+
+    Parameters
+    ----------
+    rtol : stick-slip: the last ``n`` cycles' sigma_max and sigma_min agree within
+        ``rtol`` times the stress drop and their periods within ``rtol`` (the paper:
+        1 % over three consecutive global shocks).  Steady: the last ``n`` stress means
+        agree within ``rtol`` times the velocity weakening ``|sigma - sigma_inf|``
+        (the paper: 1 % over three values), plus ``atol``.
+    atol : absolute stress tolerance added to both tests.
+    n : how many consecutive values or cycles must agree.
+    t_max : longest simulated time (None: 400 relaxation times, or 60 times the
+        time the drive needs to load one mean jump, whichever is longer).
+    """
+
+    rtol: float = 1e-2
+    atol: float = 1e-9
+    n: int = 3
+    t_max: float | None = None
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.rtol) and self.rtol > 0.0):
+            raise ValueError(f"rtol must be a finite number > 0, got {self.rtol!r}")
+        if not (math.isfinite(self.atol) and self.atol >= 0.0):
+            raise ValueError(f"atol must be a finite number >= 0, got {self.atol!r}")
+        if int(self.n) != self.n or self.n < 2:
+            raise ValueError(f"n must be an integer >= 2, got {self.n!r}")
+        if self.t_max is not None and not (math.isfinite(self.t_max) and self.t_max > 0.0):
+            raise ValueError(f"t_max must be a finite number > 0 (or None), got {self.t_max!r}")
+
+
+@dataclass
+class Run:
+    """A protocol run: the stress records, the shocks, and the final grid."""
+
+    records: pd.DataFrame
+    shocks: pd.DataFrame
+    grid: Grid
+    wall_time: float
+    status: str = "completed"
+
+    def to_frame(self) -> pd.DataFrame:
+        return self.records
+
+
+@dataclass
+class Stationary:
+    """The attractor at constant drive velocity: a steady stress or a stick-slip cycle.
+
+    ``sigma_max``, ``sigma_min`` and ``sigma_mean`` are equal on steady rows.
+    ``converged`` says whether the stopping test was met; ``message`` says why the run
+    ended.  ``records`` holds the stress time series when asked for.
+    """
+
+    model: Model
+    V: float
+    eps: float
+    regime: str
+    sigma_max: float
+    sigma_min: float
+    sigma_mean: float
+    period: float
+    converged: bool
+    message: str
+    t_end: float
+    n_cycles: int
+    wall_time: float
+    records: pd.DataFrame | None = field(default=None, repr=False)
+    shocks: pd.DataFrame | None = field(default=None, repr=False)
+    grid: Grid | None = field(default=None, repr=False)
+
+    def to_dict(self) -> dict:
+        m = self.model
+        return {
+            "k0": m.k0, "k1": m.k1, "k2": m.k2, "zbar": m.zbar, "V": self.V, "regime": self.regime,
+            "sigma_max": self.sigma_max, "sigma_min": self.sigma_min, "sigma_mean": self.sigma_mean,
+            "period": self.period, "converged": self.converged, "message": self.message,
+            "eps": self.eps, "t_end": self.t_end, "n_cycles": self.n_cycles, "wall_time": self.wall_time,
+        }
+
+
+@dataclass
+class Critical:
+    """The critical velocity from bisection: ``V_low`` is stick-slip, ``V_high`` steady."""
+
+    model: Model
+    Vc: float
+    V_low: float
+    V_high: float
+    status: str
+    message: str
+    evaluations: list[dict]
+
+    def to_dict(self) -> dict:
+        m = self.model
+        return {"k0": m.k0, "k1": m.k1, "k2": m.k2, "zbar": m.zbar, "Vc": self.Vc, "V_low": self.V_low,
+                "V_high": self.V_high, "status": self.status, "message": self.message}
+
+
+# ------------------------------------------------------------------------------ helpers
+def _check_velocity(V: float, name: str = "V") -> float:
+    V = float(V)
+    if not (math.isfinite(V) and V > 0.0):
+        raise ValueError(f"{name} must be a finite number > 0, got {V!r}")
+    return V
+
+
+def _initial_grid(model: Model, settings: GridSettings, V: float, initial) -> Grid:
+    if isinstance(initial, Grid):
+        if initial.model != model or initial.settings.eps != settings.eps:
+            raise ValueError("initial grid was built for another model or bin width")
+        grid = initial.copy()
+        grid.settings = settings
+        grid.prm[K.P_THETA_S] = settings.theta_shift
+        grid.prm[K.P_THETA_R] = settings.theta_relax
+        grid.prm[K.P_DT_MAX] = settings.dt_max
+        return grid
+    if initial == "auto":
+        # frozen dashpots if a block jumps faster than the dashpots relax
+        initial = "frozen" if V * 1.0 > model.gamma * model.zbar else "relaxed"
+    return Grid(model, settings, initial=initial)
+
+
+def _stress_resolution(model: Model, eps: float) -> float:
+    """Stress resolution of the records: fine enough for the cycles, coarse enough to skip
+    the discretisation jitter, which is of order k0 * eps / kappa per step."""
+    return model.k0 * max(2.0 * eps / model.kappa, 1e-3 * model.zbar)
+
+
+def _time_scales(model: Model, V: float) -> tuple[float, float, float]:
+    """Relaxation time, cycle time of a block (zbar / V), loading time of a mean jump."""
+    tau_u = 1.0 / model.gamma if model.gamma > 0.0 else math.inf
+    tau_c = model.zbar / V
+    tau_load = model.kappa * model.zbar / (model.k0 * V)
+    return tau_u, tau_c, tau_load
+
+
+# ------------------------------------------------------------------------------ simulate
+def simulate(
+    model: Model,
+    drive: Drive | float,
+    *,
+    duration: float | None = None,
+    numerics: Numerics | None = None,
+    initial="auto",
+    record_dsigma: float | None = None,
+    record_dt: float | None = None,
+) -> Run:
+    """Run a driving protocol and return the stress time series.
+
+    Parameters
+    ----------
+    model : the model.
+    drive : a :class:`Drive`, or a constant velocity (then ``duration`` is required).
+    numerics : bin and step limits.
+    initial : ``"auto"``, ``"frozen"``, ``"relaxed"`` or a :class:`~micro.grid.Grid` to
+        start from (it is copied).
+    record_dsigma, record_dt : record the stress whenever it has moved by
+        ``record_dsigma`` and at least every ``record_dt`` (defaults from the model).
+
+    Returns
+    -------
+    Run
+        ``records`` has columns ``t, w, sigma, sigma_min, sigma_max, sigma_mean`` (the
+        extrema and time mean over the window since the previous row).
+    """
+    if not isinstance(drive, Drive):
+        if duration is None:
+            raise ValueError("duration is required when drive is a velocity")
+        drive = Drive.uniform(float(drive), float(duration))
+    numerics = numerics or Numerics()
+    settings = numerics.settings(model)
+    first_v = next((v for _, v in drive.segments if v > 0.0), 1.0)
+    grid = _initial_grid(model, settings, first_v, initial)
+    t0 = grid.t
+    if record_dsigma is None:
+        record_dsigma = _stress_resolution(model, settings.eps)
+    if record_dt is None:
+        record_dt = drive.duration / 2000.0
+    start = time.perf_counter()
+    recs, shocks = [], []
+    w0 = float(grid.fst[K.F_W])
+    for seg_start, seg_end, v in drive.boundaries():
+        r, s, code = grid.advance(v, t0 + seg_end, record_dsigma=record_dsigma, record_dt=record_dt)
+        recs.append(r)
+        shocks.append(s)
+    rec = np.concatenate(recs) if recs else np.zeros((0, 5))
+    shk = np.concatenate(shocks) if shocks else np.zeros((0, 4))
+    t_rel = rec[:, 0] - t0
+    w = np.array([w0 + _drive_position(drive, tt) for tt in t_rel])
+    records = pd.DataFrame({"t": t_rel, "w": w, "sigma": rec[:, 1], "sigma_min": rec[:, 2],
+                            "sigma_max": rec[:, 3], "sigma_mean": rec[:, 4]})
+    shock_frame = pd.DataFrame(shk - np.array([t0, 0.0, 0.0, 0.0]), columns=["t", "sigma_before", "sigma_after", "shift"])
+    return Run(records=records, shocks=shock_frame, grid=grid, wall_time=time.perf_counter() - start)
+
+
+def _drive_position(drive: Drive, t: float) -> float:
+    w = 0.0
+    for t0, t1, v in drive.boundaries():
+        if t <= t0:
+            break
+        w += v * (min(t, t1) - t0)
+    return w
+
+
+# ------------------------------------------------------------------------------ stationary
+def stationary(
+    model: Model,
+    V: float,
+    *,
+    numerics: Numerics | None = None,
+    convergence: Convergence | None = None,
+    initial="auto",
+    keep_records: bool = False,
+    keep_grid: bool = False,
+) -> Stationary:
+    """Drive at constant ``V`` until the attractor's stress has converged, and stop there.
+
+    A steady state is reached when the stress stays flat (within the jitter of the
+    discretisation) and the means of ``n`` consecutive spans agree (see
+    :class:`Convergence`); a stick-slip cycle when ``n`` consecutive cycles agree.  If
+    neither happens by ``t_max`` the result says so (``converged=False``) and gives
+    the last estimates, with the regime judged from the trend of the oscillation.
+    """
+    V = _check_velocity(V)
+    numerics = numerics or Numerics()
+    convergence = convergence or Convergence()
+    settings = numerics.settings(model)
+    grid = _initial_grid(model, settings, V, initial)
+    start = time.perf_counter()
+
+    tau_u, tau_c, tau_load = _time_scales(model, V)
+    t_max = convergence.t_max
+    if t_max is None:
+        t_max = max(400.0 * tau_u if math.isfinite(tau_u) else 0.0, 60.0 * tau_load)
+    resolution = _stress_resolution(model, settings.eps)
+    hysteresis = 4.0 * resolution
+    span = max(tau_u if math.isfinite(tau_u) else 0.0, 20.0 * tau_c)  # one averaging span
+    chunk = max(span, min(tau_load, 0.05 * t_max))
+    s_inf = sigma_infinity(model)
+
+    rec = Records.empty()
+    shock_rows: list[np.ndarray] = []
+    t_begin = grid.t
+    regime, converged, message = "unknown", False, ""
+    out: dict = {}
+    while True:
+        t_now = grid.t
+        r, s, code = grid.advance(V, t_now + chunk, record_dsigma=resolution, record_dt=span / 20.0)
+        rec = rec.extend(Records.from_array(r))
+        if len(s):
+            shock_rows.append(s)
+        t_now = grid.t
+        elapsed = t_now - t_begin
+        # --- a converged limit cycle?
+        cycles = find_cycles(rec, hysteresis)
+        if len(cycles) >= convergence.n and cycle_converged(cycles, convergence.rtol, convergence.atol, convergence.n):
+            last = cycles.iloc[-convergence.n:]
+            regime, converged = "stick-slip", True
+            message = f"limit cycle converged over {convergence.n} cycles"
+            out = dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
+                       sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
+            break
+        # --- a steady state?  Flat over the last n spans, with agreeing span means.
+        n = convergence.n
+        if elapsed >= (n + 1) * span:
+            recent = cycles[cycles.t_end > t_now - n * span] if len(cycles) else cycles
+            edges = [t_now - (n - i) * span for i in range(n + 1)]
+            means = [rec.time_mean(a, b) for a, b in zip(edges[:-1], edges[1:])]
+            lo = rec.since(edges[0])
+            amplitude = float(lo.sigma_max.max() - lo.sigma_min.min()) if len(lo) else math.inf
+            tol = convergence.rtol * abs(means[-1] - s_inf) + convergence.atol
+            if (len(recent) == 0 and amplitude <= 4.0 * hysteresis and np.all(np.isfinite(means))
+                    and max(means) - min(means) <= tol):
+                regime, converged = "steady", True
+                message = f"steady: {n} span means agree within {tol:.3g}"
+                sigma = float(np.mean(means))
+                out = dict(sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma, period=math.nan)
+                break
+        if elapsed >= t_max or code not in (K.DONE,):
+            regime, message, out = _unconverged(rec, cycles, hysteresis, t_now, span, elapsed, t_max, code)
+            break
+        # lengthen the chunks while no cycle has shown up (slow stick-slip)
+        if len(cycles) == 0:
+            chunk = min(2.0 * chunk, max(span, 0.25 * t_max))
+        else:
+            chunk = max(span, 2.0 * float(cycles.period.iloc[-1]))
+    shocks = np.concatenate(shock_rows) if shock_rows else np.zeros((0, 4))
+    result = Stationary(
+        model=model, V=V, eps=settings.eps, regime=regime, converged=converged, message=message,
+        t_end=grid.t - t_begin, n_cycles=int(len(find_cycles(rec, hysteresis))),
+        wall_time=time.perf_counter() - start, **out,
+    )
+    if keep_records:
+        result.records = rec.to_frame()
+        result.shocks = pd.DataFrame(shocks, columns=["t", "sigma_before", "sigma_after", "shift"])
+    if keep_grid:
+        result.grid = grid
+    if not converged:
+        log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
+    return result
+
+
+def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: float, span: float,
+                 elapsed: float, t_max: float, code: int) -> tuple[str, str, dict]:
+    """Regime and best estimates of a run that did not meet its stopping test."""
+    why = f"not converged by t_max = {t_max:.4g}" if code == K.DONE else f"stopped early (kernel code {code})"
+    if len(cycles) >= 3:
+        amp = (cycles.sigma_max - cycles.sigma_min).to_numpy()
+        last = cycles.iloc[-3:]
+        ratio = float(amp[-1] / amp[-3]) ** 0.5 if amp[-3] > 0 else math.nan
+        if ratio < 0.999:
+            regime = "steady"
+            detail = f"; the oscillation decays by {ratio:.4f} per cycle (steady attractor)"
+            sigma = rec.time_mean(float(last.t_start.iloc[0]), float(last.t_end.iloc[-1]))
+            return regime, why + detail, dict(sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma, period=math.nan)
+        regime = "stick-slip"
+        detail = f"; the oscillation persists (amplitude ratio {ratio:.4f} per cycle)"
+        return regime, why + detail, dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
+                                          sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
+    sigma = rec.time_mean(t_now - span, t_now)
+    lo = rec.since(t_now - span)
+    amplitude = float(lo.sigma_max.max() - lo.sigma_min.min()) if len(lo) else math.nan
+    regime = "steady" if amplitude <= 4.0 * hysteresis else "unknown"
+    return regime, why + f"; last span amplitude {amplitude:.3g}", dict(
+        sigma_max=sigma if regime == "steady" else float(lo.sigma_max.max()),
+        sigma_min=sigma if regime == "steady" else float(lo.sigma_min.min()),
+        sigma_mean=sigma, period=math.nan)
+
+
+# ------------------------------------------------------------------------------ critical velocity
+def critical_velocity(
+    model: Model,
+    *,
+    V_min: float = 1e-4,
+    V_max: float = 1e3,
+    rel_tol: float = 1e-2,
+    numerics: Numerics | None = None,
+    convergence: Convergence | None = None,
+) -> Critical:
+    """Critical velocity by bisection on the regime (the paper's Appendix B).
+
+    Starting from ``V_min`` (expected stick-slip) and ``V_max`` (expected steady), the
+    bracket is halved geometrically until ``V_high / V_low - 1 <= rel_tol``.  If the
+    system is steady already at ``V_min`` (e.g. ``k0 >= k2``), ``Vc`` is reported as 0
+    with status ``"no stick-slip"``; if it is stick-slip at ``V_max``, as ``inf`` with
+    status ``"above range"``.
+    """
+    V_min = _check_velocity(V_min, "V_min")
+    V_max = _check_velocity(V_max, "V_max")
+    if not V_max > V_min:
+        raise ValueError(f"V_max must be > V_min, got V_min={V_min!r}, V_max={V_max!r}")
+    if not (math.isfinite(rel_tol) and 0.0 < rel_tol < 1.0):
+        raise ValueError(f"rel_tol must be in (0, 1), got {rel_tol!r}")
+    evaluations: list[dict] = []
+
+    def regime(V: float) -> str:
+        res = stationary(model, V, numerics=numerics, convergence=convergence)
+        evaluations.append(res.to_dict())
+        log.info("bisection k0=%g V=%.6g -> %s (%s)", model.k0, V, res.regime, res.message)
+        return res.regime
+
+    if regime(V_max) != "steady":
+        return Critical(model, math.inf, V_max, math.inf, "above range",
+                        f"not steady at V_max = {V_max:g}", evaluations)
+    if regime(V_min) == "steady":
+        return Critical(model, 0.0, 0.0, V_min, "no stick-slip",
+                        f"steady already at V_min = {V_min:g}", evaluations)
+    lo, hi = V_min, V_max
+    while hi / lo - 1.0 > rel_tol:
+        mid = math.sqrt(lo * hi)
+        if regime(mid) == "steady":
+            hi = mid
+        else:
+            lo = mid
+    return Critical(model, math.sqrt(lo * hi), lo, hi, "converged",
+                    f"bracket [{lo:.6g}, {hi:.6g}] within rel_tol {rel_tol:g}", evaluations)
+
+
+# ------------------------------------------------------------------------------ sweep
+def sweep(
+    model: Model,
+    velocities,
+    *,
+    numerics: Numerics | None = None,
+    convergence: Convergence | None = None,
+    continuation: bool = True,
+) -> pd.DataFrame:
+    """Stationary states for each velocity, one row each.
+
+    With ``continuation`` every point starts from the previous point's final density
+    (points are visited in the given order), which shortens transients.
+    """
+    rows = []
+    grid = None
+    for V in velocities:
+        res = stationary(model, V, numerics=numerics, convergence=convergence,
+                         initial=grid if (continuation and grid is not None) else "auto", keep_grid=continuation)
+        grid = res.grid
+        res.grid = None
+        rows.append(res.to_dict())
+    return pd.DataFrame(rows)
+
+
+# ------------------------------------------------------------------------------ slide-hold-slide
+def slide_hold_slide(
+    model: Model,
+    V: float,
+    hold_times,
+    *,
+    numerics: Numerics | None = None,
+    convergence: Convergence | None = None,
+    resume: float | None = None,
+) -> pd.DataFrame:
+    """Stress peak after a hold, for each hold time (the paper's Fig. 7).
+
+    Drives at ``V`` until stationary (steady sliding is required), then for each hold
+    time: stop the drive for ``hold``, resume at ``V`` for ``resume`` (default: 20
+    cycle times plus 2 relaxation times), and record the largest stress after
+    resuming.  One stationary run serves every hold time.  Returns ``hold_time,
+    sigma_steady, sigma_peak, delta_sigma_max`` per hold.
+    """
+    V = _check_velocity(V)
+    holds = [float(h) for h in np.atleast_1d(hold_times)]
+    for h in holds:
+        if not (math.isfinite(h) and h >= 0.0):
+            raise ValueError(f"hold times must be finite numbers >= 0, got {h!r}")
+    base = stationary(model, V, numerics=numerics, convergence=convergence, keep_grid=True)
+    if base.regime != "steady":
+        raise ValueError(f"slide-hold-slide needs steady sliding at V = {V:g}; the attractor is {base.regime}")
+    tau_u, tau_c, _ = _time_scales(model, V)
+    if resume is None:
+        resume = 20.0 * tau_c + (2.0 * tau_u if math.isfinite(tau_u) else 0.0)
+    settings = base.grid.settings
+    resolution = _stress_resolution(model, settings.eps)
+    rows = []
+    for h in holds:
+        grid = base.grid.copy()
+        t0 = grid.t
+        if h > 0.0:
+            grid.advance(0.0, t0 + h, record_dsigma=resolution, record_dt=max(h, 1e-300) / 50.0)
+        r, _, _ = grid.advance(V, grid.t + resume, record_dsigma=resolution / 4.0, record_dt=resume / 400.0)
+        peak = float(max(r[:, 3].max(), r[:, 1].max())) if len(r) else math.nan
+        rows.append({"hold_time": h, "sigma_steady": base.sigma_mean, "sigma_peak": peak,
+                     "delta_sigma_max": peak - base.sigma_mean})
+    return pd.DataFrame(rows)
