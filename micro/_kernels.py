@@ -1,33 +1,40 @@
 """Numba kernels of the Fokker-Planck (master-equation) solver.
 
+Cells
+-----
 The density P(delta_F, delta_R) is stored on cells of side ``eps`` indexed by
 
 * ``d``: the bin of the distance to threshold ``delta = delta_F + delta_R`` (the paper's
   ``i + j``), so that the stability boundary ``delta = 0`` is a column, and
 * ``j``: the bin of ``delta_R`` (a row); the delta_F bin of a cell is ``k = d - j``.
 
-Each cell carries three mass-weighted numbers:
+Each cell carries three mass-weighted numbers: its mass ``M``; ``W = M * eta``, where
+its delta_R is ``(j + eta) * eps``; and ``O = M * omega``, its mass being spread
+uniformly over the upper fraction ``omega`` of its delta_F bin (``omega = 1`` except
+where mass has crossed the threshold).  Mass that lands in the same cell merges at its
+centre of mass.  Driving and stress redistribution shift every delta_F by the same
+amount: a continuous offset ``phi`` in [0, 1) bins plus an integer column offset
+``off``.  Every move conserves mass and the first moment of delta_F exactly.
 
-* ``M``, its mass;
-* ``W = M * eta``: its delta_R position is ``(j + eta) * eps`` with ``eta`` in
-  [-1/2, 1/2).  Relaxation moves mass along delta_R exactly, with no numerical
-  diffusion; mass that lands in the same cell merges at its centre of mass.
-* ``O = M * omega``: along delta_F its mass is spread uniformly over the upper fraction
-  ``omega`` of its bin (``omega = 1`` except where mass has crossed the threshold).
+Lazy, exact relaxation
+----------------------
+Between two jumps of a block, Eq. (2) relaxes its delta_R towards
+``Y(x) = (k2/kappa)(<delta_F> - delta_F)``; for mass that does not jump, ``<delta_F> -
+delta_F`` changes only as the others jump, by ``kappa * d hbar``.  So over any
+interval since a reference time ``t_a`` the exact delta_R of such mass is
 
-Driving and stress redistribution shift every delta_F by the same amount: the shift is
-a continuous offset ``phi`` (in bins, in [0, 1)) plus an integer column offset ``off``,
-so the stress is not quantised to ``eps``.  The mass of cell ``(j, d)`` then covers
+    y(t) = lam * y_a + (1 - lam) * Ya(x) + B(t),    lam = exp(-gamma (t - t_a)),
 
-    delta in [(hi - omega) eps, hi eps),   hi = d + 1 - phi + eta.
+with ``Ya(x) = Y(x) - k2 (hbar(t) - hbar(t_a))`` and ``B`` one drift accumulator common to
+all cells.  The stored delta_R are those of time ``t_a`` ("stale"): the threshold logic
+uses the true positions of the few cells near it, mass that jumps is stored
+pre-compensated (so that the next synchronisation relaxes it only from its jump on),
+and a synchronisation moves every cell to its true position and resets ``t_a``.  The
+relaxation is therefore exact in time; synchronising only bounds how stale the stored
+positions get.
 
-The part below ``delta = 0`` is unstable: its mass jumps (``delta_F += kappa z``,
-``delta_R`` unchanged: the dashpot is rigid during the jump) and lands with the exact
-bin integrals of the distribution of ``kappa z``.  All moves conserve mass and the
-first moments of delta_F and delta_R exactly.
-
-Arrays of integers ``ist`` and floats ``fst`` carry the scalar state (``I_*`` and
-``F_*`` indices); ``prm`` carries the model constants (``P_*``).
+Arrays of integers ``ist`` and floats ``fst`` carry the scalar state (``I_*``, ``F_*``);
+``prm`` the constants (``P_*``).
 """
 from __future__ import annotations
 
@@ -42,33 +49,37 @@ F_W = 1  # drive position w
 F_HBAR = 2  # mean block position hbar
 F_SIGMA = 3  # stress k0 (w - hbar)
 F_PHI = 4  # continuous shift in bins, [0, 1)
-F_MEANX = 5  # sum of M * delta_F
-F_JUMPS = 6  # cumulative number of jumps per block
-F_PENDING = 7  # time not relaxed yet (negative: relaxed ahead, see advance)
-F_SLIP_RATE = 8  # d hbar / dt over the last step
-F_DISP = 9  # mass-weighted mean |delta_R_inf - delta_R| (sets the relaxation step)
-F_NEG = 10  # most negative cell mass seen (stays 0)
-F_MASS = 11  # total mass (diagnostic)
-F_WIN_START = 12  # time of the last record (start of the current window)
-F_WIN_MIN = 13  # smallest stress in the window
-F_WIN_MAX = 14  # largest stress in the window
-F_WIN_INT = 15  # time integral of the stress over the window
-F_WIN_LEN = 16  # time covered by F_WIN_INT
-F_OWED = 17  # shift (bins) owed but not applied yet (|owed| <= OWED_TOL, or an iteration cap)
-F_REC_SIGMA = 18  # stress at the last record
-N_FSTATE = 19
+F_SUMX = 5  # sum of M * delta_F
+F_JUMPS = 6  # cumulative jumps per block
+F_TREF = 7  # time t_a of the stored delta_R
+F_HREF = 8  # hbar at t_a
+F_LAM = 9  # exp(-gamma (t - t_a))
+F_DRIFT = 10  # B(t)
+F_LAM_SYNC = 11  # synchronise once F_LAM falls to this
+F_SLIP_RATE = 12  # d hbar / dt over the last step
+F_NEG = 13  # most negative cell mass seen (stays 0)
+F_MASS = 14  # total mass
+F_WIN_START = 15  # time of the last record
+F_WIN_MIN = 16
+F_WIN_MAX = 17
+F_WIN_INT = 18
+F_WIN_LEN = 19
+F_OWED = 20  # shift (bins) owed to the next step
+F_REC_SIGMA = 21  # stress at the last record
+N_FSTATE = 22
 
 # --- integer state -----------------------------------------------------------------
 I_OFF = 0  # column of d = 0
 I_JBASE = 1  # delta_R bin j of row 0
 I_RLO = 2  # first occupied row
 I_RHI = 3  # one past the last occupied row
-I_STEPS = 4  # time steps taken
-I_ITER = 5  # closure iterations taken
-I_NREC = 6  # records written
-I_NSHOCK = 7  # shocks written
+I_STEPS = 4
+I_ITER = 5
+I_NREC = 6
+I_NSHOCK = 7
 I_CUR = 8  # which of the two buffers holds the density
-N_ISTATE = 9
+I_SYNCS = 9  # synchronisations done
+N_ISTATE = 10
 
 # --- parameters ----------------------------------------------------------------------
 P_K0 = 0
@@ -84,11 +95,12 @@ P_D0 = 9  # distribution constants, in units of the landing displacement s = kap
 P_D1 = 10
 P_D2 = 11
 P_THETA_S = 12  # largest shift per step, in bins
-P_THETA_R = 13  # largest typical relaxation displacement per step, in bins
-P_DT_MAX = 14  # largest time step
-P_SHOCK = 15  # closure shift (bins) above which a step is recorded as a shock
-P_REC_DSIGMA = 16  # record when the stress has moved this much since the last record
-N_PARAM = 17
+P_THETA_R = 13  # largest relaxation of a near-threshold cell between synchronisations, in bins
+P_DT_MAX = 14
+P_SHOCK = 15  # a step whose cascade shifts more bins than this is a shock
+P_REC_DSIGMA = 16  # record when the stress has moved this much
+P_S_MAX = 17  # largest landing displacement kappa z kept
+N_PARAM = 18
 
 # --- return codes ---------------------------------------------------------------------
 DONE = 0
@@ -98,15 +110,20 @@ RECORDS_FULL = 3
 SHOCKS_FULL = 4
 MAX_STEPS = 5
 STOP_EVENT = 6
+INTERNAL_ERROR = 7
 
+#: Stored columns scanned on each side of the threshold.  Synchronisations keep every
+#: cell's stored position within SCAN - 2 bins of its true one.
+SCAN = 4
 #: An injection stops once the mass left in its tail is below this; the rest goes into
-#: its last cell (mass stays exact, the tail beyond is not resolved).
+#: its last cell (mass stays exact).
 TAIL_FLOOR = 1e-16
 #: Cell edges within this many bins of the threshold count as on it.
 EDGE_TOL = 1e-9
-#: The closure stops once less than this many bins are owed; the remainder is carried
-#: exactly to the next step.
+#: The closure stops once less than this many bins are owed; the rest is carried.
 OWED_TOL = 1e-2
+#: Largest shift (bins) of one closure iteration: the scan covers SCAN bins of margin.
+MAX_SHIFT = 2.0
 
 
 @njit(cache=True, inline="always")
@@ -123,19 +140,15 @@ def landing_cdf(s: float, prm: np.ndarray, table: np.ndarray) -> float:
     """Cumulative distribution of the landing displacement ``s = kappa z``."""
     if s <= 0.0:
         return 0.0
+    if s >= prm[P_S_MAX]:
+        return 1.0
     kind = int(prm[P_KIND])
     if kind == 0:
-        # exponential: D0 = kappa * scale, D1 = kappa * cutoff, D2 = normalisation
-        if s >= prm[P_D1]:
-            return 1.0
+        # exponential: D0 = kappa * scale, D2 = normalisation (the cutoff is in S_MAX)
         return -math.expm1(-s / prm[P_D0]) / prm[P_D2]
     if kind == 1:
-        # deterministic: D0 = kappa * zbar
-        return 1.0 if s >= prm[P_D0] else 0.0
-    # tabulated on s = i * D0, i = 0..n-1; D1 = s_max
-    if s >= prm[P_D1]:
-        return 1.0
-    u = s / prm[P_D0]
+        return 1.0 if s >= prm[P_D0] else 0.0  # deterministic: D0 = kappa * zbar
+    u = s / prm[P_D0]  # tabulated on s = i * D0
     i = int(u)
     if i >= table.shape[0] - 1:
         return 1.0
@@ -143,115 +156,216 @@ def landing_cdf(s: float, prm: np.ndarray, table: np.ndarray) -> float:
     return table[i] * (1.0 - f) + table[i + 1] * f
 
 
-@njit(cache=True)
-def inject_row(M, W, O, r, jbase, off, phi, eps, mass, eta, depth, prm, table, chi, clo):
-    """Deposit ``mass`` that jumps from below the threshold of row ``r``.
+# ------------------------------------------------------------------------ relaxation
+@njit(cache=True, inline="always")
+def _target(fst, prm, x):
+    """Ya(x): the relaxation target of delta_R at delta_F = x, in the frame of t_a."""
+    return (prm[P_K2] / prm[P_KAPPA]) * (fst[F_SUMX] / fst[F_MASS] - x) - prm[P_K2] * (fst[F_HBAR] - fst[F_HREF])
 
-    The mass has delta_R offset ``eta`` and sits on average ``depth`` bins below
-    ``delta = 0`` (for mass that crossed during a shift of ``s`` bins, ``depth = s/2``):
-    it lands at ``delta = kappa z - depth * eps``.  The part that would land below
-    threshold jumps again at once (a geometric series, summed exactly).  Returns
-    ``(number of jumps, change of sum(M * delta_F))``.
+
+@njit(cache=True, inline="always")
+def _correction(fst, prm, y, x):
+    """True minus stored delta_R of mass stored at ``y`` with delta_F ``x``."""
+    return (1.0 - fst[F_LAM]) * (_target(fst, prm, x) - y) + fst[F_DRIFT]
+
+
+@njit(cache=True, inline="always")
+def _stored(fst, prm, y_true, x, p_lam):
+    """Stored delta_R of mass that has true delta_R ``y_true`` now and jumped when the
+    relaxation factor since t_a was ``p_lam``: the next synchronisation relaxes it by
+    ``F_LAM / p_lam`` only."""
+    ya = _target(fst, prm, x)
+    return ya + (y_true - fst[F_DRIFT] - ya) / p_lam
+
+
+# ------------------------------------------------------------------------ jumps
+@njit(cache=True)
+def inject(M, W, O, ist, fst, prm, table, chi, clo, mass, y_true, depth, p_lam):
+    """Deposit ``mass`` that jumps from delta_R = ``y_true``, ``depth`` bins below threshold.
+
+    The mass lands at ``delta = kappa z - depth * eps`` (delta_R unchanged), i.e. at
+    delta_F = ``kappa z - depth * eps - y_true``; what would land below threshold jumps
+    again at once (a geometric series, summed exactly).  Each landing delta_F bin gets
+    the exact integral of the jump distribution and is stored pre-compensated for lazy
+    relaxation.  Returns ``(number of jumps, change of sum(M * delta_F))``; a landing row
+    (column) outside the arrays returns ``(-1, 0)`` (``(-2, 0)``) before anything is written.
     """
+    eps = prm[P_EPS]
+    phi = fst[F_PHI]
+    off = ist[I_OFF]
+    jb = ist[I_JBASE]
+    nrow = M.shape[0]
     ncol = M.shape[1]
-    theta = eta - phi + depth  # bin d receives kappa z / eps in [d + theta, d + 1 + theta)
-    f_cut = landing_cdf(depth * eps, prm, table)
+    s_cut = depth * eps
+    f_cut = landing_cdf(s_cut, prm, table)
     if f_cut >= 1.0:
         f_cut = 1.0 - 1e-15
     scale = mass / (1.0 - f_cut)  # mass that jumps, counting repeated jumps
-    j = r + jbase
-    x_exit = -(j + eta + depth) * eps  # mean delta_F of the mass that jumps
-    half_shift = depth
-    d = int(math.floor(half_shift - theta))
-    c = off + d
-    first = c
-    f_lo = f_cut
-    moment = 0.0
+    x_exit = -(y_true + s_cut)  # delta_F of the jumping mass
+    s_to_x = y_true + s_cut  # delta_F = s - s_to_x
+    k_first = int(math.floor(-y_true / eps + phi))  # bin of the threshold, x = -y_true
+    # --- landing rows and columns: y_stored is linear in x, so its ends bound it
+    s_end = prm[P_S_MAX]
+    for s_probe in (s_cut, s_end):
+        x = s_probe - s_to_x
+        ys = _stored(fst, prm, y_true, x, p_lam)
+        jp = int(math.floor(ys / eps + 0.5))
+        kp = int(math.floor(x / eps + phi))
+        if jp - jb < 1 or jp - jb > nrow - 2:
+            return -1.0, 0.0
+        if off + kp + jp > ncol - 2 or off + kp + jp < 1:
+            return -2.0, 0.0
     exponential = int(prm[P_KIND]) == 0
+    moment = 0.0
+    f_lo = f_cut
+    k = k_first
     if exponential:
-        # F(s) = (1 - exp(-s/b)) / norm for s < s_max: one multiplication per bin
         b = prm[P_D0]
-        s_max = prm[P_D1]
         norm = prm[P_D2]
-        s_hi = (d + 1 + theta) * eps
+        s_hi = (k + 1 - phi) * eps + s_to_x
         e_hi = math.exp(-s_hi / b)
         ratio = math.exp(-eps / b)
+    # the stored delta_R is linear in the landing delta_F: step it bin by bin
+    g_slope = (prm[P_K2] / prm[P_KAPPA]) * (1.0 / p_lam - 1.0)  # d y_stored / d x
+    x_full = (k + 0.5 - phi) * eps  # centre of a full bin k
+    u_full = _stored(fst, prm, y_true, x_full, p_lam) / eps
+    du = g_slope  # per bin (x advances by eps, u by g_slope * eps / eps)
+    r_min = nrow
+    r_max = -1
+    c_min = ncol
+    c_max = -1
     while True:
-        if c >= ncol - 1 or (1.0 - f_lo) * scale < TAIL_FLOOR:
-            c = min(c, ncol - 1)  # fold the far tail into this column (conserves mass)
-            f_hi = 1.0
+        s_lo_bin = (k - phi) * eps + s_to_x
+        s_hi = (k + 1 - phi) * eps + s_to_x
+        if (1.0 - f_lo) * scale < TAIL_FLOOR or s_hi >= prm[P_S_MAX]:
+            f_hi = 1.0  # fold the rest of the tail into this bin (mass stays exact)
         elif exponential:
-            f_hi = (1.0 - e_hi) / norm if s_hi < s_max else 1.0
-            e_hi *= ratio
-            s_hi += eps
+            f_hi = (1.0 - e_hi) / norm
         else:
-            f_hi = landing_cdf((d + 1 + theta) * eps, prm, table)
+            f_hi = landing_cdf(s_hi, prm, table)
+        if exponential:
+            e_hi *= ratio
         dm = (f_hi - f_lo) * scale
         if dm > 0.0:
-            part = (d + 1 + theta) - max(d + theta, half_shift)  # filled fraction of the bin
+            part = (s_hi - max(s_lo_bin, s_cut)) / eps  # filled fraction of the delta_F bin
+            if part >= 1.0:
+                part = 1.0
+                u = u_full
+            else:
+                u = u_full + du * 0.5 * (1.0 - part)  # centre of the filled part is higher
+            x = (k + 1 - phi - 0.5 * part) * eps
+            jp = int(math.floor(u + 0.5))
+            r = jp - jb
+            c = off + k + jp
             M[r, c] += dm
-            W[r, c] += dm * eta
+            W[r, c] += dm * (u - jp)
             O[r, c] += dm * part
-            moment += dm * ((d - j + 1 - phi - 0.5 * part) * eps - x_exit)
+            if r < r_min:
+                r_min = r
+            if r > r_max:
+                r_max = r
+            if c < c_min:
+                c_min = c
+            if c > c_max:
+                c_max = c
+            moment += dm * (x - x_exit)
         f_lo = f_hi
-        if f_hi >= 1.0 or c == ncol - 1:
+        if f_hi >= 1.0:
             break
-        d += 1
-        c += 1
-    if c + 1 > chi[r]:
-        chi[r] = c + 1
-    if first < clo[r]:
-        clo[r] = first
+        k += 1
+        u_full += du
+    # occupied extents (a landing run spans few rows: widen each touched row to the run)
+    for r in range(r_min, r_max + 1):
+        if c_min < clo[r]:
+            clo[r] = c_min
+        if c_max + 1 > chi[r]:
+            chi[r] = c_max + 1
+    if r_min < ist[I_RLO]:
+        ist[I_RLO] = r_min
+    if r_max + 1 > ist[I_RHI]:
+        ist[I_RHI] = r_max + 1
     return scale, moment
 
 
+# ------------------------------------------------------------------------ threshold
 @njit(cache=True)
-def threshold_rate(M, W, O, off, phi, rlo, rhi):
-    """Mass that crosses ``delta = 0`` per bin of shift, from the cells touching it.
-
-    A cell whose mass sits in ``[lo, hi)`` (in bins) with ``lo`` within ``EDGE_TOL`` of
-    the threshold loses ``M / omega`` per bin; mass already below the threshold (left by
-    a merge) counts as crossing at once.
-    """
-    rate = 0.0
-    for r in range(rlo, rhi):
-        for d in range(-1, 2):
-            c = off + d
-            m = M[r, c]
-            if m <= 0.0:
-                continue
-            omega = O[r, c] / m
-            lo = d + 1 - phi + W[r, c] / m - omega
-            if lo <= EDGE_TOL and omega > EDGE_TOL:
-                rate += m / omega
-    return rate
-
-
-@njit(cache=True)
-def shift_and_jump(M, W, O, ist, fst, prm, table, chi, clo, shift, ex_m, ex_w, ex_d):
-    """Shift every delta_F down by ``shift`` bins and make the mass that crosses jump.
-
-    Returns ``(jumped mass, change of sum(M * delta_F) by the jumps)``.
-    """
-    off = ist[I_OFF]
-    phi = fst[F_PHI]
+def crossing_candidates(M, W, O, ist, fst, prm, clo, cand):
+    """Cells that a shift of up to MAX_SHIFT bins can carry across ``delta = 0``: fills
+    rows of ``cand`` with (true lower edge in bins, filled fraction, mass) and returns
+    how many."""
     eps = prm[P_EPS]
-    rlo = ist[I_RLO]
-    rhi = ist[I_RHI]
-    phi_b = phi + shift
-    any_exit = False
-    for r in range(rlo, rhi):
-        em = 0.0
-        ew = 0.0
-        ed = 0.0
-        for d in range(-1, 2):
+    phi = fst[F_PHI]
+    off = ist[I_OFF]
+    jb = ist[I_JBASE]
+    n = 0
+    for r in range(ist[I_RLO], ist[I_RHI]):
+        if clo[r] > off + SCAN:
+            continue
+        j = r + jb
+        for d in range(-SCAN, SCAN + 1):
             c = off + d
             m = M[r, c]
             if m <= 0.0:
                 continue
             eta = W[r, c] / m
             omega = O[r, c] / m
-            hi = d + 1 - phi_b + eta  # upper edge after the shift
+            x = (d - j + 1 - phi - 0.5 * omega) * eps
+            lo = d + 1 - phi + eta + _correction(fst, prm, (j + eta) * eps, x) / eps - omega
+            if lo < MAX_SHIFT and n < cand.shape[0]:
+                cand[n, 0] = lo
+                cand[n, 1] = omega
+                cand[n, 2] = m
+                n += 1
+    return n
+
+
+@njit(cache=True, inline="always")
+def _crossing(cand, n, shift):
+    """Mass of the candidates below ``delta = 0`` after a shift of ``shift`` bins."""
+    total = 0.0
+    for i in range(n):
+        lo = cand[i, 0]
+        if lo >= shift:
+            continue
+        omega = cand[i, 1]
+        if omega <= EDGE_TOL or shift - lo >= omega:
+            total += cand[i, 2]
+        else:
+            total += cand[i, 2] * (shift - lo) / omega
+    return total
+
+
+@njit(cache=True)
+def shift_and_jump(M, W, O, ist, fst, prm, table, chi, clo, shift, ex_m, ex_y, ex_d, p_lam):
+    """Shift every delta_F down by ``shift`` bins and make the mass that crosses jump.
+
+    Exits are pooled by true delta_R bin in ``ex_*`` (which must be zero or hold exits
+    still waiting) and landed by :func:`inject_exits`.  Returns ``(jumped mass, change
+    of sum(M * delta_F))``, or ``(-1 or -2, moment so far)`` if a landing fell outside
+    the arrays (the shift is applied; the exits wait in ``ex_*``).
+    """
+    off = ist[I_OFF]
+    phi = fst[F_PHI]
+    eps = prm[P_EPS]
+    jb = ist[I_JBASE]
+    nrow = M.shape[0]
+    phi_b = phi + shift
+    any_exit = False
+    for r in range(ist[I_RLO], ist[I_RHI]):
+        if clo[r] > off + SCAN:
+            continue
+        j = r + jb
+        for d in range(-SCAN, SCAN + 1):
+            c = off + d
+            m = M[r, c]
+            if m <= 0.0:
+                continue
+            eta = W[r, c] / m
+            omega = O[r, c] / m
+            y = (j + eta) * eps
+            x = (d - j + 1 - phi - 0.5 * omega) * eps  # before the shift
+            corr = _correction(fst, prm, y, x)
+            hi = d + 1 - phi_b + eta + corr / eps  # true upper edge after the shift
             if hi - omega >= 0.0 and omega > EDGE_TOL:
                 continue
             if hi <= EDGE_TOL or omega <= EDGE_TOL:
@@ -267,44 +381,57 @@ def shift_and_jump(M, W, O, ist, fst, prm, table, chi, clo, shift, ex_m, ex_w, e
                 M[r, c] = keep
                 W[r, c] = keep * eta
                 O[r, c] = keep * hi
-            em += out
-            ew += out * eta
-            ed += out * depth
-        ex_m[r] = em
-        ex_w[r] = ew
-        ex_d[r] = ed
-        if em > 0.0:
+            # exits are pooled by their true delta_R bin: landing is linear in delta_R,
+            # so one landing per pool keeps every first moment exact
+            pool = int(math.floor((y + corr) / eps + 0.5)) - jb
+            pool = min(max(pool, 0), nrow - 1)
+            ex_m[pool] += out
+            ex_y[pool] += out * (y + corr)
+            ex_d[pool] += out * depth
             any_exit = True
-    fst[F_MEANX] -= shift * eps * fst[F_MASS]
-    if phi_b >= 1.0 - 1e-12:
-        phi_b -= 1.0
-        if phi_b < 0.0:
-            phi_b = 0.0
-        off += 1
-        ist[I_OFF] = off
+    fst[F_SUMX] -= shift * eps * fst[F_MASS]
+    whole = int(math.floor(phi_b + 1e-12))
+    if whole > 0:
+        phi_b = max(phi_b - whole, 0.0)
+        ist[I_OFF] = off + whole
     fst[F_PHI] = phi_b
+    if not any_exit:
+        return 0.0, 0.0
+    return inject_exits(M, W, O, ist, fst, prm, table, chi, clo, ex_m, ex_y, ex_d, p_lam)
+
+
+@njit(cache=True)
+def inject_exits(M, W, O, ist, fst, prm, table, chi, clo, ex_m, ex_y, ex_d, p_lam):
+    """Land the exits collected per row in ``ex_*``; rows whose landing fits are cleared.
+    Returns ``(jumped, moment)``, or ``(-1 or -2, moment so far)`` if some landing did
+    not fit the rows (columns)."""
     jumped = 0.0
     moment = 0.0
-    if any_exit:
-        jb = ist[I_JBASE]
-        for r in range(rlo, rhi):
-            em = ex_m[r]
-            if em > 0.0:
-                n, dmom = inject_row(M, W, O, r, jb, off, phi_b, eps, em, ex_w[r] / em, ex_d[r] / em, prm, table, chi, clo)
-                jumped += n
-                moment += dmom
-        fst[F_MEANX] += moment
+    failed = 0.0
+    for r in range(ex_m.shape[0]):
+        em = ex_m[r]
+        if em > 0.0:
+            n, dmom = inject(M, W, O, ist, fst, prm, table, chi, clo, em, ex_y[r] / em, ex_d[r] / em, p_lam)
+            if n < 0.0:
+                failed = n
+                continue
+            ex_m[r] = 0.0
+            ex_y[r] = 0.0
+            ex_d[r] = 0.0
+            jumped += n
+            moment += dmom
+    fst[F_SUMX] += moment
+    if failed < 0.0:
+        return failed, moment
     return jumped, moment
 
 
 @njit(cache=True)
 def _apply_jumps(fst, prm, jumped, moment):
-    """Account for jumps that moved sum(M * delta_F) by ``moment``.
-
-    The mean block position moves by ``moment / kappa``, the stress drops by ``k0``
-    times that, and every delta_F owes a further shift of ``(k1 + k2)`` times that
-    (the stress redistribution).  Returns the owed shift in bins.
-    """
+    """Account for jumps that moved sum(M * delta_F) by ``moment``: hbar moves by
+    ``moment / kappa``, the stress drops by ``k0`` times that and every delta_F owes a
+    further shift of ``(k1 + k2)`` times that (the redistribution).  Returns the owed
+    shift in bins."""
     dh = moment / prm[P_KAPPA]
     fst[F_HBAR] += dh
     fst[F_SIGMA] -= prm[P_K0] * dh
@@ -313,18 +440,18 @@ def _apply_jumps(fst, prm, jumped, moment):
 
 
 @njit(cache=True)
-def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_w, ex_d, max_iter):
+def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_y, ex_d, p_lam, cand, max_iter):
     """Apply ``owed`` bins of shift and the stress redistribution it triggers.
 
-    With ``c`` the redistribution (in bins) per bin of shift from the cells touching the
-    threshold, the closure ``shift = owed + c * shift`` gives ``shift = owed / (1 - c)``;
-    the exits of that shift are then computed exactly cell by cell, and what the linear
-    prediction missed (cells that start or stop crossing within the shift) is owed
-    again.  An avalanche (``c >= 1``) applies what it owes, at most up to the next column
-    boundary, and goes on.  A small negative remainder (the prediction overshot) is
-    carried to the next step rather than dropped, so that
-    ``sum(M * delta_F) + sigma - owed * eps`` stays exactly constant.  Returns the total
-    shift in bins and the number of iterations.
+    The shift that closes the cascade solves ``shift = owed + c * crossing(shift)``
+    (``c`` the redistribution per unit of crossing mass); the exits of that shift are
+    then computed exactly, and what the prediction missed (mass landing within the
+    shift, the true mean jump) is owed again.
+    An avalanche (``c >= 1``) applies what it owes, at most ``MAX_SHIFT`` bins at a
+    time, and goes on.  The remainder (below ``OWED_TOL``, possibly negative) is
+    carried in ``F_OWED``, so ``sum(M * delta_F) + sigma - owed * eps`` is exactly
+    constant.  Returns ``(total shift, iterations, code)``: ``code`` is DONE, or
+    NEED_ROWS / NEED_COLS when a landing did not fit the arrays (the exits wait in ``ex_*``).
     """
     eps = prm[P_EPS]
     c_per_mass = (prm[P_K1] + prm[P_K2]) * prm[P_ZMEAN] / eps
@@ -332,75 +459,59 @@ def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_w, ex_d, 
     it = 0
     while owed > OWED_TOL and it < max_iter:
         it += 1
-        c = c_per_mass * threshold_rate(M, W, O, ist[I_OFF], fst[F_PHI], ist[I_RLO], ist[I_RHI])
-        step = owed / (1.0 - c) if c < 1.0 else owed
-        room = 1.0 - fst[F_PHI]
-        if step > room:
-            step = room
-        jumped, moment = shift_and_jump(M, W, O, ist, fst, prm, table, chi, clo, step, ex_m, ex_w, ex_d)
+        # solve shift = owed + c_per_mass * crossing_mass(shift) by fixed-point iteration
+        # on the predicted exits (monotone from below); an avalanche hits MAX_SHIFT
+        n_cand = crossing_candidates(M, W, O, ist, fst, prm, clo, cand)
+        step = owed
+        for _ in range(200):
+            if step >= MAX_SHIFT:
+                step = MAX_SHIFT
+                break
+            new_step = owed + c_per_mass * _crossing(cand, n_cand, step)
+            if abs(new_step - step) <= 1e-3 * OWED_TOL:
+                step = new_step
+                break
+            step = new_step
+        if step > MAX_SHIFT:
+            step = MAX_SHIFT
+        jumped, moment = shift_and_jump(M, W, O, ist, fst, prm, table, chi, clo, step, ex_m, ex_y, ex_d, p_lam)
         total += step
         owed -= step
+        if jumped < 0.0:
+            owed += _apply_jumps(fst, prm, 0.0, moment)
+            fst[F_OWED] = owed
+            return total, it, NEED_ROWS if jumped > -1.5 else NEED_COLS
         if jumped > 0.0:
             owed += _apply_jumps(fst, prm, jumped, moment)
     fst[F_OWED] = owed
-    return total, it
+    return total, it, DONE
 
 
+# ------------------------------------------------------------------------ synchronisation
 @njit(cache=True)
-def bounds_after_relax(ist, fst, prm, lam, clo, chi):
-    """Rows and columns that a relaxation by factor ``lam`` can reach: ``(rmin, rmax, cmax)``."""
-    eps = prm[P_EPS]
-    g = prm[P_K2] / prm[P_KAPPA]
-    off = ist[I_OFF]
-    phi = fst[F_PHI]
-    jb = ist[I_JBASE]
-    mean_x = fst[F_MEANX] / fst[F_MASS]
-    rmin = 1 << 60
-    rmax = -(1 << 60)
-    cmax = -(1 << 60)
-    for r in range(ist[I_RLO], ist[I_RHI]):
-        if chi[r] <= clo[r]:
-            continue
-        j = r + jb
-        for k in (clo[r] - off - j, chi[r] - 1 - off - j):
-            x = (k + 0.5 - phi) * eps
-            yinf = g * (mean_x - x)
-            for y in ((j - 0.5) * eps, (j + 0.5) * eps):
-                jp = int(math.floor((yinf + lam * (y - yinf)) / eps + 0.5))
-                rmin = min(rmin, jp - jb - 1)
-                rmax = max(rmax, jp - jb + 1)
-                cmax = max(cmax, off + k + jp + 1)
-    return rmin, rmax, cmax
+def synchronise(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_n, ex_m, ex_y, ex_d):
+    """Move every cell to its true delta_R (exact relaxation since t_a) and reset t_a.
 
-
-@njit(cache=True)
-def relax(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_n, dt, ex_m, ex_w, ex_d):
-    """Relax every delta_R for a time ``dt`` (Eq. B3) and make the mass it carries across threshold jump.
-
-    .. math:: \\delta_R \\to \\delta_R^\\infty + (\\delta_R - \\delta_R^\\infty) e^{-k_2 dt/\\eta_u},
-              \\qquad \\delta_R^\\infty = \\frac{k_2}{\\kappa}(\\langle\\delta_F\\rangle - \\delta_F)
-
-    Reads ``M, W, O`` (and zeroes them), writes ``Mn, Wn, On`` (which must be zero).
-    Recomputes the sums of mass and delta_F and the mean relaxation displacement.
-    Returns ``(jumped mass, change of sum(M * delta_F) by the jumps)``.
+    Reads and zeroes ``M, W, O``; writes ``Mn, Wn, On`` (zero on entry).  Mass found
+    below threshold (only within rounding, since exits follow the true positions) jumps.
+    Sets the relaxation factor at which to synchronise next: when a near-threshold cell
+    may have moved ``P_THETA_R`` bins, or any cell ``SCAN - 2`` bins closer to the
+    threshold than stored.  Returns ``(jumped, moment, code)``.
     """
     eps = prm[P_EPS]
-    g = prm[P_K2] / prm[P_KAPPA]
-    lam = math.exp(-prm[P_GAMMA] * dt)
     off = ist[I_OFF]
     phi = fst[F_PHI]
     jb = ist[I_JBASE]
-    mean_x = fst[F_MEANX] / fst[F_MASS]
     nrow = M.shape[0]
     new_rlo = nrow
     new_rhi = 0
     sum_x = 0.0
     sum_m = 0.0
-    sum_disp = 0.0
     neg = 0.0
+    need = 0.5  # smallest safe 1 - lam until the next synchronisation
     for r in range(nrow):
         ex_m[r] = 0.0
-        ex_w[r] = 0.0
+        ex_y[r] = 0.0
         ex_d[r] = 0.0
     for r in range(ist[I_RLO], ist[I_RHI]):
         j = r + jb
@@ -418,23 +529,18 @@ def relax(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_n, dt,
                 continue
             k = c - off - j
             x = (k + 1 - phi - 0.5 * omega) * eps
+            y = (j + eta) * eps + _correction(fst, prm, (j + eta) * eps, x)
             sum_x += m * x
             sum_m += m
-            y = (j + eta) * eps
-            yinf = g * (mean_x - x)
-            sum_disp += m * abs(yinf - y)
-            u = (yinf + lam * (y - yinf)) / eps
+            u = y / eps
             jp = int(math.floor(u + 0.5))
             etap = u - jp
             rp = jp - jb
             cp = off + k + jp
-            if rp < new_rlo:
-                new_rlo = rp
-            if rp + 1 > new_rhi:
-                new_rhi = rp + 1
+            if rp < 1 or rp > nrow - 2 or cp > Mn.shape[1] - 2:
+                return -1.0, 0.0, INTERNAL_ERROR  # bounds() rules this out
             hi = k + jp + 1 - phi + etap
             if hi - omega < 0.0:
-                # relaxation carried part of the cell below threshold: that part jumps
                 if hi <= EDGE_TOL:
                     out = m
                     depth = 0.5 * omega - hi
@@ -442,10 +548,14 @@ def relax(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_n, dt,
                     out = m * (1.0 - hi / omega)
                     depth = 0.5 * (omega - hi)
                 ex_m[rp] += out
-                ex_w[rp] += out * etap
+                ex_y[rp] += out * y
                 ex_d[rp] += out * depth
                 m -= out
                 omega = hi
+            if rp < new_rlo:
+                new_rlo = rp
+            if rp + 1 > new_rhi:
+                new_rhi = rp + 1
             if m > 0.0:
                 Mn[rp, cp] += m
                 Wn[rp, cp] += m * etap
@@ -460,21 +570,69 @@ def relax(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_n, dt,
         fst[F_NEG] = neg
     ist[I_RLO] = new_rlo
     ist[I_RHI] = new_rhi
-    fst[F_MEANX] = sum_x
+    fst[F_SUMX] = sum_x
     fst[F_MASS] = sum_m
-    fst[F_DISP] = sum_disp / sum_m if sum_m > 0.0 else 0.0
-    jumped = 0.0
-    moment = 0.0
+    fst[F_TREF] = fst[F_T]
+    fst[F_HREF] = fst[F_HBAR]
+    fst[F_LAM] = 1.0
+    fst[F_DRIFT] = 0.0
+    # --- schedule: every cell's possible relaxation against its distance to the scan
+    mean_x = sum_x / sum_m
+    g = prm[P_K2] / prm[P_KAPPA]
     for r in range(new_rlo, new_rhi):
-        em = ex_m[r]
-        if em > 0.0:
-            n, dmom = inject_row(Mn, Wn, On, r, jb, off, phi, eps, em, ex_w[r] / em, ex_d[r] / em, prm, table, chi_n, clo_n)
-            jumped += n
-            moment += dmom
-    fst[F_MEANX] += moment
-    return jumped, moment
+        j = r + jb
+        for c in range(clo_n[r], chi_n[r]):
+            m = Mn[r, c]
+            if m <= 0.0:
+                continue
+            eta = Wn[r, c] / m
+            omega = On[r, c] / m
+            x = (c - off - j + 1 - phi - 0.5 * omega) * eps
+            pull = abs(g * (mean_x - x) - (j + eta) * eps) / eps  # full relaxation, in bins
+            if pull <= 0.0:
+                continue
+            lo = c - off + 1 - phi + eta - omega  # true lower edge, bins
+            allowed = prm[P_THETA_R] if lo < SCAN else max(prm[P_THETA_R], lo - (SCAN - 2))
+            if allowed / pull < need:
+                need = allowed / pull
+    fst[F_LAM_SYNC] = 1.0 - need
+    # jumps of mass found below threshold
+    jumped, moment = inject_exits(Mn, Wn, On, ist, fst, prm, table, chi_n, clo_n, ex_m, ex_y, ex_d, 1.0)
+    if jumped < 0.0:
+        return -1.0, moment, NEED_ROWS if jumped > -1.5 else NEED_COLS
+    return jumped, moment, DONE
 
 
+@njit(cache=True)
+def bounds(ist, fst, prm, clo, chi):
+    """Rows and columns that the true positions, or a full relaxation from them, can
+    reach: ``(rmin, rmax, cmax)``."""
+    eps = prm[P_EPS]
+    g = prm[P_K2] / prm[P_KAPPA]
+    off = ist[I_OFF]
+    phi = fst[F_PHI]
+    jb = ist[I_JBASE]
+    mean_x = fst[F_SUMX] / fst[F_MASS]
+    rmin = 1 << 60
+    rmax = -(1 << 60)
+    cmax = -(1 << 60)
+    for r in range(ist[I_RLO], ist[I_RHI]):
+        if chi[r] <= clo[r]:
+            continue
+        j = r + jb
+        for k in (clo[r] - off - j, chi[r] - 1 - off - j):
+            for frac in (0.0, 1.0):
+                x = (k + frac - phi) * eps
+                for y in ((j - 0.5) * eps, (j + 0.5) * eps):
+                    for yy in (y + _correction(fst, prm, y, x), g * (mean_x - x)):
+                        jp = int(math.floor(yy / eps + 0.5))
+                        rmin = min(rmin, jp - jb - 1)
+                        rmax = max(rmax, jp - jb + 1)
+                        cmax = max(cmax, off + k + jp + 1)
+    return rmin, rmax, cmax
+
+
+# ------------------------------------------------------------------------ records
 @njit(cache=True)
 def _record(rec, ist, fst, t, sigma):
     """Write one record (the window since the previous record) and open a new window."""
@@ -493,24 +651,23 @@ def _record(rec, ist, fst, t, sigma):
     fst[F_WIN_LEN] = 0.0
 
 
+# ------------------------------------------------------------------------ the loop
 @njit(cache=True)
-def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, ex_d,
+def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, ex_d, cand,
             velocity, t_stop, max_steps, cols_needed, rec, rec_dt, shocks, stop_shocks):
     """Advance the density from ``fst[F_T]`` to ``t_stop`` at drive velocity ``velocity``.
 
-    One step: drive by ``velocity * dt`` and close the cascade of shifts, jumps and
-    stress redistribution it triggers; relax the dashpots (Eq. B3) for the time elapsed
-    since the last relaxation whenever the typical displacement that has accumulated
-    reaches ``P_THETA_R`` bins (a lazy Lie splitting: relaxation is exact in time, so
-    applying it less often only delays it).  The step keeps the shift within
-    ``P_THETA_S`` bins and does not pass ``t_stop``.
+    One step advances the time by ``dt`` (the relaxation is carried by the lazy
+    representation), drives by ``velocity * dt`` and closes the cascade of shifts,
+    jumps and redistribution.  ``dt`` keeps the shift within ``P_THETA_S`` bins.  When
+    the relaxation factor has fallen to ``F_LAM_SYNC`` every cell is synchronised.
 
-    Records ``t, sigma, min sigma, max sigma, time-mean sigma`` (over the window since
-    the previous record) whenever the stress has moved by ``P_REC_DSIGMA`` since the last
-    record, ``rec_dt`` has passed, or a shock happens (then one record just before it and
-    one just after).  A step whose cascade shifts more than ``P_SHOCK`` bins is a shock,
-    also listed as ``t, sigma before, sigma after, shift in bins``.  Returns a code
-    telling why it stopped; on ``NEED_ROWS`` and ``NEED_COLS`` the state is untouched.
+    Records ``t, sigma, min, max, time mean`` (over the window since the previous
+    record) whenever the stress has moved ``P_REC_DSIGMA`` since the last record, after
+    at most ``rec_dt``, and on both sides of every shock (a step whose cascade shifts
+    more than ``P_SHOCK`` bins; also listed as ``t, sigma before, sigma after, shift``).
+    Returns a code telling why it stopped; on ``NEED_ROWS`` / ``NEED_COLS`` the caller
+    grows the arrays and calls again (pending exits wait in ``ex_*``).
     """
     k0 = prm[P_K0]
     eps = prm[P_EPS]
@@ -518,6 +675,17 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, 
     ncol = bufM.shape[2]
     nrow = bufM.shape[1]
     steps = 0
+    a = ist[I_CUR]
+    # exits left pending by a previous NEED_* return
+    for r in range(nrow):
+        if ex_m[r] > 0.0:
+            jumped, moment = inject_exits(bufM[a], bufW[a], bufO[a], ist, fst, prm, table, bufchi[a], bufclo[a],
+                                          ex_m, ex_y, ex_d, max(fst[F_LAM], 1e-300))
+            if jumped < 0.0:
+                fst[F_OWED] += _apply_jumps(fst, prm, 0.0, moment)
+                return NEED_ROWS if jumped > -1.5 else NEED_COLS
+            fst[F_OWED] += _apply_jumps(fst, prm, jumped, moment)
+            break
     while True:
         t = fst[F_T]
         if t_stop - t <= 1e-14 * max(1.0, abs(t_stop)):
@@ -525,32 +693,12 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, 
         if steps >= max_steps:
             return MAX_STEPS
         off = ist[I_OFF]
-        if off < 3 or off + cols_needed + 3 > ncol:
+        if off < SCAN + 3 or off + cols_needed + SCAN + 3 > ncol:
             return NEED_COLS
-        # --- step size
-        shift_rate = (k0 * velocity + (prm[P_K1] + prm[P_K2]) * fst[F_SLIP_RATE]) / eps
-        dt = prm[P_DT_MAX]
-        if shift_rate > 0.0:
-            dt = min(dt, prm[P_THETA_S] / shift_rate)
-        relax_rate = gamma * fst[F_DISP] / eps
-        if relax_rate > 0.0 and 0.5 * prm[P_THETA_R] / relax_rate > fst[F_PENDING]:
-            dt = min(dt, 0.5 * prm[P_THETA_R] / relax_rate - fst[F_PENDING])
-        dt = min(dt, t_stop - t)
-        # --- relaxation, lazily and centred in time: an event relaxes for the time since
-        # the previous event's midpoint plus half the interval to the next one (the same
-        # as this one), so that the relaxation events sit at the centres of the intervals
-        # they stand for (second-order splitting).  An interval is as long as it takes the
-        # typical displacement to reach P_THETA_R bins.
         a = ist[I_CUR]
-        owed = fst[F_OWED]
-        tau = fst[F_PENDING] + dt
-        relax_rate = gamma * fst[F_DISP] / eps
-        interval = prm[P_THETA_R] / relax_rate if relax_rate > 0.0 else 0.0
-        end = t + dt >= t_stop * (1.0 - 1e-15)
-        if gamma > 0.0 and (tau >= 0.5 * interval * (1.0 - 1e-12) or end):
-            ahead = 0.0 if end else 0.5 * interval
-            lam = math.exp(-gamma * (tau + ahead))
-            rmin, rmax, cmax = bounds_after_relax(ist, fst, prm, lam, bufclo[a], bufchi[a])
+        # --- synchronise when the stored positions are too stale
+        if gamma > 0.0 and (fst[F_LAM] <= fst[F_LAM_SYNC] or abs(fst[F_DRIFT]) > eps):
+            rmin, rmax, cmax = bounds(ist, fst, prm, bufclo[a], bufchi[a])
             if rmin < 1 or rmax > nrow - 2:
                 return NEED_ROWS
             if cmax > ncol - 2:
@@ -559,38 +707,51 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, 
             for r in range(nrow):
                 bufchi[b, r] = 0
                 bufclo[b, r] = ncol
-            jumped, moment = relax(bufM[a], bufW[a], bufO[a], bufM[b], bufW[b], bufO[b], ist, fst, prm, table,
-                                   bufchi[a], bufclo[a], bufchi[b], bufclo[b], tau + ahead, ex_m, ex_w, ex_d)
+            jumped, moment, code = synchronise(bufM[a], bufW[a], bufO[a], bufM[b], bufW[b], bufO[b], ist, fst, prm,
+                                               table, bufchi[a], bufclo[a], bufchi[b], bufclo[b], ex_m, ex_y, ex_d)
+            if code == INTERNAL_ERROR:
+                return code
             ist[I_CUR] = b
+            ist[I_SYNCS] += 1
             a = b
-            fst[F_PENDING] = -ahead
-            if jumped > 0.0:
-                owed += _apply_jumps(fst, prm, jumped, moment)
-        else:
-            fst[F_PENDING] = tau
+            fst[F_OWED] += _apply_jumps(fst, prm, max(jumped, 0.0), moment)
+            if code != DONE:
+                return code
         M = bufM[a]
         W = bufW[a]
         O = bufO[a]
         chi = bufchi[a]
         clo = bufclo[a]
-        # --- drive, then the cascade it triggers
+        # --- step size: the shift, and the relaxation until the next synchronisation
+        shift_rate = (k0 * velocity + (prm[P_K1] + prm[P_K2]) * fst[F_SLIP_RATE]) / eps
+        dt = prm[P_DT_MAX]
+        if shift_rate > 0.0:
+            dt = min(dt, prm[P_THETA_S] / shift_rate)
+        if gamma > 0.0 and fst[F_LAM] > fst[F_LAM_SYNC]:
+            dt = min(dt, math.log(fst[F_LAM] / fst[F_LAM_SYNC]) / gamma * (1.0 + 1e-9))
+        dt = min(dt, t_stop - t)
+        # --- time advance: relaxation factor and drift (hbar is constant within the step)
+        lam_step = math.exp(-gamma * dt)
+        fst[F_DRIFT] = lam_step * fst[F_DRIFT] + prm[P_K2] * (fst[F_HBAR] - fst[F_HREF]) * (1.0 - lam_step)
+        fst[F_LAM] *= lam_step
+        # --- drive, then the cascade it triggers (the jumps happen at the end of the step)
         sigma_prev = fst[F_SIGMA]
         hbar_prev = fst[F_HBAR]
         fst[F_T] = t + dt
         fst[F_W] += velocity * dt
         fst[F_SIGMA] += k0 * velocity * dt
-        owed += k0 * velocity * dt / eps
+        owed = fst[F_OWED] + k0 * velocity * dt / eps
         sigma_before = fst[F_SIGMA]
-        total, it = close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_w, ex_d, 100000000)
+        total, it, code = close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_y, ex_d,
+                                     max(fst[F_LAM], 1e-300), cand, 100000000)
         ist[I_ITER] += it
         fst[F_SLIP_RATE] = (fst[F_HBAR] - hbar_prev) / dt
         steps += 1
         ist[I_STEPS] += 1
         sigma_after = fst[F_SIGMA]
         # --- records.  The state after the cascade is the accurate one (within a step the
-        # drive is applied before the jumps it causes, a splitting sawtooth): averages and
-        # extrema use post-cascade values; the value before the cascade counts only as the
-        # peak before a shock.
+        # drive is applied before the jumps it causes): averages and extrema use
+        # post-cascade values; the value before the cascade counts only as a shock's peak.
         shock = total > prm[P_SHOCK]
         if shock:
             fst[F_WIN_MAX] = max(fst[F_WIN_MAX], sigma_before)
@@ -610,6 +771,8 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_w, 
         if (shock or abs(sigma_after - fst[F_REC_SIGMA]) >= prm[P_REC_DSIGMA]
                 or fst[F_T] - fst[F_WIN_START] >= rec_dt or fst[F_T] >= t_stop * (1.0 - 1e-15)):
             _record(rec, ist, fst, fst[F_T], sigma_after)
+        if code != DONE:
+            return code
         if ist[I_NREC] + 2 >= rec.shape[0]:
             return RECORDS_FULL
         if ist[I_NSHOCK] >= shocks.shape[0]:

@@ -32,7 +32,9 @@ class GridSettings:
     eps : bin width of delta_F and delta_R.  Must resolve a mean jump,
         ``eps <= kappa * zbar / 4``.
     theta_shift : largest shift of delta_F per time step, in bins (0 < theta_shift <= 1).
-    theta_relax : largest typical relaxation of delta_R per time step, in bins.
+    theta_relax : how far (in bins) a cell near the threshold may relax between two
+        synchronisations of the stored delta_R (the relaxation itself is exact; this
+        bounds how stale the stored positions get), 0 < theta_relax <= 2.
     dt_max : largest time step (may be infinite).
     """
 
@@ -50,6 +52,8 @@ class GridSettings:
             raise ValueError(f"dt_max must be > 0, got {self.dt_max!r}")
         if self.theta_shift > 1.0:
             raise ValueError(f"theta_shift must be in (0, 1], got {self.theta_shift!r}")
+        if self.theta_relax > 2.0:
+            raise ValueError(f"theta_relax must be in (0, 2], got {self.theta_relax!r}")
 
     def check(self, model: Model) -> None:
         """Check that ``eps`` resolves the model's mean jump ``kappa * zbar``."""
@@ -121,6 +125,7 @@ class Grid:
         prm[K.P_THETA_R] = settings.theta_relax
         prm[K.P_DT_MAX] = settings.dt_max
         prm[K.P_SHOCK] = 8.0
+        prm[K.P_S_MAX] = s_max
         self.prm = prm
         self.ist = np.zeros(K.N_ISTATE, dtype=np.int64)
         self.fst = np.zeros(K.N_FSTATE)
@@ -133,9 +138,11 @@ class Grid:
         self.bufO = np.zeros((2, nrow, ncol))
         self.bufchi = np.zeros((2, nrow), dtype=np.int64)
         self.bufclo = np.full((2, nrow), ncol, dtype=np.int64)
+        # exits waiting to land (kept across calls if a landing needs more room)
         self.ex_m = np.zeros(nrow)
-        self.ex_w = np.zeros(nrow)
+        self.ex_y = np.zeros(nrow)
         self.ex_d = np.zeros(nrow)
+        self.cand = np.zeros(((2 * K.SCAN + 1) * nrow, 3))
 
     def _build_initial(self, initial: str) -> None:
         model, eps = self.model, self.settings.eps
@@ -183,10 +190,11 @@ class Grid:
         # x (delta_F) centre of every cell, from its bin
         k = d - j
         mean_x = float(np.sum(weight * (k + 0.5) * eps))
-        fst[K.F_MEANX] = mean_x
+        fst[K.F_SUMX] = mean_x
         fst[K.F_MASS] = 1.0
         fst[K.F_SIGMA] = model.f_th - mean_x
-        fst[K.F_DISP] = float(np.sum(weight * np.abs(model.k2 / model.kappa * (mean_x - (k + 0.5) * eps) - y)))
+        fst[K.F_LAM] = 1.0
+        fst[K.F_LAM_SYNC] = 1.0  # synchronise (and schedule) at the first step
         fst[K.F_WIN_MIN] = fst[K.F_SIGMA]
         fst[K.F_WIN_MAX] = fst[K.F_SIGMA]
         fst[K.F_REC_SIGMA] = fst[K.F_SIGMA]
@@ -204,7 +212,7 @@ class Grid:
     @property
     def sigma_grid(self) -> float:
         """Stress from the grid, ``f_th - <delta_F>`` (equal to :attr:`sigma` up to discretisation)."""
-        return float(self.model.f_th - self.fst[K.F_MEANX])
+        return float(self.model.f_th - self.fst[K.F_SUMX] / self.fst[K.F_MASS])
 
     def density(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The current cell masses, delta_R offsets ``eta`` and filled fractions ``omega``."""
@@ -223,16 +231,20 @@ class Grid:
         return float(min(self.density()[0].min(), self.fst[K.F_NEG]))
 
     def cells(self) -> dict[str, np.ndarray]:
-        """Occupied cells as arrays: mass, delta_F centre, delta_R, delta."""
+        """Occupied cells as arrays: mass, delta_F (centre), delta_R and delta, at the
+        current time (the stored delta_R are corrected for the relaxation since the last
+        synchronisation)."""
         M, eta, omega = self.density()
         eps = self.settings.eps
         r, c = np.nonzero(M)
         j = r + int(self.ist[K.I_JBASE])
         d = c - int(self.ist[K.I_OFF])
         phi = float(self.fst[K.F_PHI])
-        e = eta[r, c]
         x = (d - j + 1 - phi - 0.5 * omega[r, c]) * eps
-        y = (j + e) * eps
+        y_stored = (j + eta[r, c]) * eps
+        m = self.model
+        target = m.k2 / m.kappa * (self.fst[K.F_SUMX] / self.fst[K.F_MASS] - x) - m.k2 * (self.fst[K.F_HBAR] - self.fst[K.F_HREF])
+        y = y_stored + (1.0 - self.fst[K.F_LAM]) * (target - y_stored) + self.fst[K.F_DRIFT]
         return {"mass": M[r, c], "delta_F": x, "delta_R": y, "delta": x + y}
 
     # ----------------------------------------------------------------------------- growth
@@ -240,11 +252,12 @@ class Grid:
         cur = int(self.ist[K.I_CUR])
         M = self.bufM[cur]
         chi, clo = self.bufchi[cur], self.bufclo[cur]
-        # lam = 0 bounds every relaxation (delta_R moves between its value and its target)
-        rmin, rmax, _ = K.bounds_after_relax(self.ist, self.fst, self.prm, 0.0, clo, chi)
+        # rows a full relaxation can reach; landings of pre-compensated jumps can reach
+        # further, so grow generously on both sides
+        rmin, rmax, _ = K.bounds(self.ist, self.fst, self.prm, clo, chi)
         nrow = M.shape[0]
-        add_lo = max(0, 2 - rmin) + 8 + nrow // 4
-        add_hi = max(0, rmax - (nrow - 3)) + 8 + nrow // 4
+        add_lo = max(0, 2 - rmin) + 16 + nrow // 2
+        add_hi = max(0, rmax - (nrow - 3)) + 16 + nrow // 2
         new_rows = nrow + add_lo + add_hi
         self._reshape(new_rows, M.shape[1], add_lo, 0)
         log.debug("grid rows %d -> %d", nrow, new_rows)
@@ -256,7 +269,7 @@ class Grid:
         off = int(self.ist[K.I_OFF])
         rlo, rhi = int(self.ist[K.I_RLO]), int(self.ist[K.I_RHI])
         occupied = chi[rlo:rhi] > clo[rlo:rhi]
-        c_first = min(int(clo[rlo:rhi][occupied].min()) if occupied.any() else off, off - 2)
+        c_first = min(int(clo[rlo:rhi][occupied].min()) if occupied.any() else off, off - K.SCAN - 2)
         c_last = max(int(chi[rlo:rhi][occupied].max()) if occupied.any() else off, off + self.cols_needed)
         ncol = M.shape[1]
         width = c_last - c_first
@@ -264,6 +277,8 @@ class Grid:
         need = width + self.cols_needed // 2 + 16
         new_ncol = ncol if need <= ncol else int(need * 1.5)
         shift = c_first - 4
+        if off - shift + self.cols_needed + K.SCAN + 3 > new_ncol:
+            new_ncol = off - shift + self.cols_needed + K.SCAN + 16
         self._reshape(M.shape[0], new_ncol, 0, -shift)
         log.debug("grid columns %d -> %d, shifted by %d", ncol, new_ncol, -shift)
 
@@ -277,7 +292,10 @@ class Grid:
         vals_m = oldM[r_old, c_old]
         vals_w = oldW[r_old, c_old]
         vals_o = oldO[r_old, c_old]
+        pending = [a.copy() for a in (self.ex_m, self.ex_y, self.ex_d)]
         self._allocate(nrow, ncol)
+        for new, old in zip((self.ex_m, self.ex_y, self.ex_d), pending):
+            new[row_shift:row_shift + old.size] = old
         r_new = r_old + row_shift
         c_new = c_old + col_shift
         if c_new.size and (c_new.min() < 0 or c_new.max() >= ncol or r_new.min() < 0 or r_new.max() >= nrow):
@@ -301,7 +319,7 @@ class Grid:
         """An independent copy of the grid and its state (to branch a protocol)."""
         new = object.__new__(Grid)
         new.__dict__.update(self.__dict__)
-        for name in ("bufM", "bufW", "bufO", "bufchi", "bufclo", "ex_m", "ex_w", "ex_d", "ist", "fst", "prm"):
+        for name in ("bufM", "bufW", "bufO", "bufchi", "bufclo", "ex_m", "ex_y", "ex_d", "cand", "ist", "fst", "prm"):
             setattr(new, name, getattr(self, name).copy())
         return new
 
@@ -337,7 +355,7 @@ class Grid:
             remaining_shocks = stop_after_shocks - seen_shocks if stop_after_shocks > 0 else 0
             code = K.advance(
                 self.bufM, self.bufW, self.bufO, self.bufchi, self.bufclo, self.ist, self.fst, self.prm,
-                self.table, self.ex_m, self.ex_w, self.ex_d, float(velocity), float(t_stop), max_steps,
+                self.table, self.ex_m, self.ex_y, self.ex_d, self.cand, float(velocity), float(t_stop), max_steps,
                 self.cols_needed, rec, float(record_dt), shk, remaining_shocks,
             )
             n_rec = int(self.ist[K.I_NREC])
@@ -353,6 +371,8 @@ class Grid:
                 self._recentre_or_grow_cols()
             elif code in (K.RECORDS_FULL, K.SHOCKS_FULL):
                 continue
+            elif code == K.INTERNAL_ERROR:
+                raise RuntimeError("internal error in the Fokker-Planck kernel: a synchronisation left the grid")
             else:
                 break
         out_rec = np.concatenate(records) if records else np.zeros((0, 5))

@@ -41,6 +41,7 @@ import numpy as np
 import pandas as pd
 
 from micro import _nblock_kernels as K
+from micro.analytic import sigma_deterministic_steady, sigma_fast_limit, sigma_slow_limit
 from micro.params import Deterministic, Exponential, JumpDistribution, Model, Tabulated
 
 __all__ = [
@@ -713,27 +714,6 @@ def stick_slip_extrema_nblock(
 # ---------------------------------------------------------------------------------------
 # analytic results the tests compare with (derived in docs/micro_nblock.md)
 # ---------------------------------------------------------------------------------------
-def sigma_deterministic_steady(model: Model, velocity: float) -> float:
-    r"""Eq. (4): the stationary stress for deterministic jumps :math:`g(z) = \delta(z - \bar z)`.
-
-    .. math:: \sigma(V) = f_{th} - \left[V\eta_u - \frac{\bar z k_2}{e^{\bar z k_2/V\eta_u} - 1}\right]
-              - \frac{\bar z}{2}(k_0 + k_1)
-
-    It assumes steady sliding (each block jumps every :math:`\bar z / V`); it uses the mean of
-    ``model.jumps`` as :math:`\bar z` and is exact only for :class:`Deterministic` jumps.
-    """
-    _check_model(model)
-    v = _check_float("velocity", velocity, low=0.0)
-    zbar, k2, eta = model.jumps.mean, model.k2, model.eta_u
-    if v == 0.0:
-        bracket = 0.0
-    else:
-        a = zbar * k2 / (v * eta)
-        if a < 1e-6:
-            bracket = 0.5 * zbar * k2 - zbar * zbar * k2 * k2 / (12.0 * v * eta)
-        else:
-            bracket = v * eta - zbar * k2 / math.expm1(a)
-    return model.f_th - bracket - 0.5 * zbar * (model.k0 + model.k1)
 
 
 def sigma_deterministic_steady_finite_n(model: Model, velocity: float, n_blocks: int) -> float:
@@ -767,54 +747,10 @@ def sigma_deterministic_steady_finite_n(model: Model, velocity: float, n_blocks:
     return sigma_before - 0.5 * k0 * zbar / n
 
 
-def _residual_variance(dist: JumpDistribution, n_grid: int = 400_001) -> float:
-    r"""Variance of the equilibrium residual R (density :math:`(1 - G(r))/\langle z\rangle`),
-    :math:`\langle z^3\rangle/(3\langle z\rangle) - (\langle z^2\rangle/(2\langle z\rangle))^2`, by the midpoint rule."""
-    edges = np.linspace(0.0, float(dist.z_max), n_grid)
-    mid = 0.5 * (edges[1:] + edges[:-1])
-    weight = (1.0 - np.asarray(dist.cdf(mid), dtype=float)) * np.diff(edges)
-    total = weight.sum()
-    mean = float(np.sum(weight * mid) / total)
-    second = float(np.sum(weight * mid * mid) / total)
-    return second - mean * mean
 
 
-def sigma_fast_limit(model: Model, velocity: float | None = None) -> float:
-    r"""The large-V stationary stress for any g.
-
-    .. math:: \sigma(V) = f_{th} - \kappa \frac{\langle z^2\rangle}{2\langle z\rangle}
-              + \frac{k_2 \gamma}{V} \operatorname{Var}(R) + O(V^{-2})
-
-    At :math:`V \to \infty` dashpots are frozen and every :math:`\delta_i` is a renewal
-    process that decreases at speed :math:`\kappa V` and jumps by :math:`\kappa z`; its
-    mean is :math:`\kappa` times the mean residual. Eq. (6) is the deterministic case
-    (:math:`\kappa \bar z / 2`). With ``velocity`` the first correction is added: the
-    dashpot slows the decrease of :math:`\delta` by :math:`k_2\gamma(\langle R\rangle - R)`,
-    which reweights the residual R (whose variance is :math:`\bar z^2/12` for deterministic
-    g, reproducing the large-V expansion of Eq. (4), and :math:`\approx \bar z^2` for
-    exponential g). Valid for :math:`V \gg \gamma \bar z`.
-    """
-    _check_model(model)
-    sigma = model.f_th - model.kappa * model.jumps.mean_residual
-    if velocity is not None:
-        v = _check_float("velocity", velocity, low=0.0, strict=True)
-        sigma += model.k2 * model.gamma * _residual_variance(model.jumps) / v
-    return sigma
 
 
-def sigma_slow_limit(model: Model, velocity: float = 0.0) -> float:
-    r"""The small-V stationary stress for k0 > k2 (steady quasi-static sliding), any g:
-
-    .. math:: \sigma(V) = f_{th} - (k_0 + k_1)\frac{\langle z^2\rangle}{2\langle z\rangle} - \eta_u V + O(V^2)
-
-    Dashpots relax between a block's jumps, so its relaxed margin is a renewal process with
-    increments :math:`(k_0+k_1) z`; a block jumps when the common relaxed signal lags
-    :math:`\bar h` by :math:`V/\gamma`, i.e. with relaxed margin :math:`k_2 V/\gamma = \eta_u V`.
-    Eq. (5) is the deterministic case at V = 0.
-    """
-    _check_model(model)
-    v = _check_float("velocity", velocity, low=0.0)
-    return model.f_th - (model.k0 + model.k1) * model.jumps.mean_residual - model.eta_u * v
 
 
 # ---------------------------------------------------------------------------------------

@@ -11,13 +11,14 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from . import _kernels as K
 from .analysis import Records, cycle_converged, find_cycles
+from .analytic import sigma_fast_limit
 from .grid import Grid, GridSettings
 from .params import Model
 from .protocols import Drive
@@ -29,7 +30,6 @@ __all__ = [
     "Stationary",
     "Critical",
     "default_eps",
-    "sigma_infinity",
     "simulate",
     "stationary",
     "critical_velocity",
@@ -48,13 +48,6 @@ def default_eps(model: Model) -> float:
     return model.kappa * model.zbar * EPS_FRACTION
 
 
-def sigma_infinity(model: Model) -> float:
-    r"""Stationary stress for :math:`V \to \infty`: dashpots frozen, each delta renews with
-    increments :math:`\kappa z`, so :math:`\sigma = f_{th} - \kappa\langle z^2\rangle / (2\langle z\rangle)`
-    (Eq. (6) for deterministic jumps; :math:`f_{th} - \kappa\bar z` for exponential ones)."""
-    return model.f_th - model.kappa * model.jumps.mean_residual
-
-
 @dataclass(frozen=True)
 class Numerics:
     """Discretisation: bin ``eps`` (default :func:`default_eps`) and the step limits."""
@@ -68,8 +61,8 @@ class Numerics:
             raise ValueError(f"eps must be a finite number > 0 (or None for the default), got {self.eps!r}")
         if not (0.0 < self.theta_shift <= 1.0):
             raise ValueError(f"theta_shift must be in (0, 1], got {self.theta_shift!r}")
-        if not (math.isfinite(self.theta_relax) and self.theta_relax > 0.0):
-            raise ValueError(f"theta_relax must be a finite number > 0, got {self.theta_relax!r}")
+        if not (0.0 < self.theta_relax <= 2.0):
+            raise ValueError(f"theta_relax must be in (0, 2], got {self.theta_relax!r}")
 
     def settings(self, model: Model) -> GridSettings:
         eps = default_eps(model) if self.eps is None else float(self.eps)
@@ -319,7 +312,7 @@ def stationary(
     hysteresis = 4.0 * resolution
     span = max(tau_u if math.isfinite(tau_u) else 0.0, 20.0 * tau_c)  # one averaging span
     chunk = max(span, min(tau_load, 0.05 * t_max))
-    s_inf = sigma_infinity(model)
+    s_inf = sigma_fast_limit(model)
 
     rec = Records.empty()
     shock_rows: list[np.ndarray] = []
