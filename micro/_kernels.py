@@ -100,7 +100,8 @@ P_DT_MAX = 14
 P_SHOCK = 15  # a step whose cascade shifts more bins than this is a shock
 P_REC_DSIGMA = 16  # record when the stress has moved this much
 P_S_MAX = 17  # largest landing displacement kappa z kept
-N_PARAM = 18
+P_PULL_LAND = 18  # largest relaxation pull (bins) of mass landing between synchronisations
+N_PARAM = 19
 
 # --- return codes ---------------------------------------------------------------------
 DONE = 0
@@ -113,15 +114,24 @@ STOP_EVENT = 6
 INTERNAL_ERROR = 7
 
 #: Stored columns scanned on each side of the threshold.  Synchronisations keep every
-#: cell's stored position within SCAN - 2 bins of its true one.
+#: cell's stored position within SCAN - 2 bins of its true one (the drift adds at most
+#: one more bin), so every cell whose true position is near the threshold is scanned.
 SCAN = 4
+#: Cells lighter than this do not constrain the synchronisation schedule (if one is
+#: missed at the threshold it jumps at the next synchronisation instead).
+LIGHT = 1e-14
 #: An injection stops once the mass left in its tail is below this; the rest goes into
 #: its last cell (mass stays exact).
 TAIL_FLOOR = 1e-16
 #: Cell edges within this many bins of the threshold count as on it.
 EDGE_TOL = 1e-9
-#: The closure stops once less than this many bins are owed; the rest is carried.
-OWED_TOL = 1e-2
+#: The closure stops once it owes less than this fraction of the step's drive (and at
+#: least OWED_FLOOR bins); the rest is carried exactly to the next step.  It must be
+#: relative: for small k0 the drive is only a fraction 1 - c ~ k0/kappa of each step's
+#: shift, and an absolute tolerance above it would skip cascades and make the step-size
+#: control alternate stick and slip (a spurious cycle of stress drop theta_shift * eps).
+OWED_REL = 0.1
+OWED_FLOOR = 1e-12
 #: Largest shift (bins) of one closure iteration: the scan covers SCAN bins of margin.
 MAX_SHIFT = 2.0
 
@@ -440,7 +450,7 @@ def _apply_jumps(fst, prm, jumped, moment):
 
 
 @njit(cache=True)
-def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_y, ex_d, p_lam, cand, max_iter):
+def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, tol, ex_m, ex_y, ex_d, p_lam, cand, max_iter):
     """Apply ``owed`` bins of shift and the stress redistribution it triggers.
 
     The shift that closes the cascade solves ``shift = owed + c * crossing(shift)``
@@ -457,7 +467,7 @@ def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_y, ex_d, 
     c_per_mass = (prm[P_K1] + prm[P_K2]) * prm[P_ZMEAN] / eps
     total = 0.0
     it = 0
-    while owed > OWED_TOL and it < max_iter:
+    while owed > tol and it < max_iter:
         it += 1
         # solve shift = owed + c_per_mass * crossing_mass(shift) by fixed-point iteration
         # on the predicted exits (monotone from below); an avalanche hits MAX_SHIFT
@@ -468,7 +478,7 @@ def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_y, ex_d, 
                 step = MAX_SHIFT
                 break
             new_step = owed + c_per_mass * _crossing(cand, n_cand, step)
-            if abs(new_step - step) <= 1e-3 * OWED_TOL:
+            if abs(new_step - step) <= 1e-3 * tol:
                 step = new_step
                 break
             step = new_step
@@ -576,25 +586,31 @@ def synchronise(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_
     fst[F_HREF] = fst[F_HBAR]
     fst[F_LAM] = 1.0
     fst[F_DRIFT] = 0.0
-    # --- schedule: every cell's possible relaxation against its distance to the scan
+    # --- schedule: the next synchronisation comes before any cell's correction
+    # (1 - lam) * pull can exceed SCAN - 2 bins, or P_THETA_R bins for a cell at the
+    # threshold; mass that lands meanwhile pulls at most P_PULL_LAND bins.
     mean_x = sum_x / sum_m
     g = prm[P_K2] / prm[P_KAPPA]
+    pull_all = prm[P_PULL_LAND]
+    pull_near = 0.0
     for r in range(new_rlo, new_rhi):
         j = r + jb
         for c in range(clo_n[r], chi_n[r]):
             m = Mn[r, c]
-            if m <= 0.0:
+            if m <= LIGHT:
                 continue
             eta = Wn[r, c] / m
             omega = On[r, c] / m
             x = (c - off - j + 1 - phi - 0.5 * omega) * eps
             pull = abs(g * (mean_x - x) - (j + eta) * eps) / eps  # full relaxation, in bins
-            if pull <= 0.0:
-                continue
-            lo = c - off + 1 - phi + eta - omega  # true lower edge, bins
-            allowed = prm[P_THETA_R] if lo < SCAN else max(prm[P_THETA_R], lo - (SCAN - 2))
-            if allowed / pull < need:
-                need = allowed / pull
+            if pull > pull_all:
+                pull_all = pull
+            if c - off + 1 - phi + eta - omega < SCAN and pull > pull_near:
+                pull_near = pull
+    if pull_all > 0.0:
+        need = min(need, (SCAN - 2) / pull_all)
+    if pull_near > 0.0:
+        need = min(need, prm[P_THETA_R] / pull_near)
     fst[F_LAM_SYNC] = 1.0 - need
     # jumps of mass found below threshold
     jumped, moment = inject_exits(Mn, Wn, On, ist, fst, prm, table, chi_n, clo_n, ex_m, ex_y, ex_d, 1.0)
@@ -740,9 +756,11 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, 
         fst[F_T] = t + dt
         fst[F_W] += velocity * dt
         fst[F_SIGMA] += k0 * velocity * dt
-        owed = fst[F_OWED] + k0 * velocity * dt / eps
+        drive = k0 * velocity * dt / eps
+        owed = fst[F_OWED] + drive
         sigma_before = fst[F_SIGMA]
-        total, it, code = close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, ex_m, ex_y, ex_d,
+        tol = max(OWED_FLOOR, OWED_REL * drive)
+        total, it, code = close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, tol, ex_m, ex_y, ex_d,
                                      max(fst[F_LAM], 1e-300), cand, 100000000)
         ist[I_ITER] += it
         fst[F_SLIP_RATE] = (fst[F_HBAR] - hbar_prev) / dt

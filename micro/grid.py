@@ -126,6 +126,10 @@ class Grid:
         prm[K.P_DT_MAX] = settings.dt_max
         prm[K.P_SHOCK] = 8.0
         prm[K.P_S_MAX] = s_max
+        # a landing after a jump of z pulls delta_R by up to about k2 z (plus what the
+        # jumping mass already had): bound it by the z that only 1e-12 of jumps exceed
+        z_hi = float(np.asarray(model.jumps.quantile(np.array([1.0 - 1e-12])))[0])
+        prm[K.P_PULL_LAND] = 2.0 * model.k2 * z_hi / eps
         self.prm = prm
         self.ist = np.zeros(K.N_ISTATE, dtype=np.int64)
         self.fst = np.zeros(K.N_FSTATE)

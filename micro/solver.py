@@ -122,7 +122,9 @@ class Run:
 class Stationary:
     """The attractor at constant drive velocity: a steady stress or a stick-slip cycle.
 
-    ``sigma_max``, ``sigma_min`` and ``sigma_mean`` are equal on steady rows.
+    ``sigma_max``, ``sigma_min`` and ``sigma_mean`` are equal on steady rows;
+    ``sigma_stderr`` is the statistical error of ``sigma_mean`` from the discretisation
+    jitter (the solver is deterministic, but its stress jitters at the scale k0 * eps).
     ``converged`` says whether the stopping test was met; ``message`` says why the run
     ended.  ``records`` holds the stress time series when asked for.
     """
@@ -140,6 +142,7 @@ class Stationary:
     t_end: float
     n_cycles: int
     wall_time: float
+    sigma_stderr: float = math.nan
     records: pd.DataFrame | None = field(default=None, repr=False)
     shocks: pd.DataFrame | None = field(default=None, repr=False)
     grid: Grid | None = field(default=None, repr=False)
@@ -149,7 +152,8 @@ class Stationary:
         return {
             "k0": m.k0, "k1": m.k1, "k2": m.k2, "zbar": m.zbar, "V": self.V, "regime": self.regime,
             "sigma_max": self.sigma_max, "sigma_min": self.sigma_min, "sigma_mean": self.sigma_mean,
-            "period": self.period, "converged": self.converged, "message": self.message,
+            "period": self.period, "sigma_stderr": self.sigma_stderr, "converged": self.converged,
+            "message": self.message,
             "eps": self.eps, "t_end": self.t_end, "n_cycles": self.n_cycles, "wall_time": self.wall_time,
         }
 
@@ -196,10 +200,16 @@ def _initial_grid(model: Model, settings: GridSettings, V: float, initial) -> Gr
     return Grid(model, settings, initial=initial)
 
 
-def _stress_resolution(model: Model, eps: float) -> float:
-    """Stress resolution of the records: fine enough for the cycles, coarse enough to skip
-    the discretisation jitter, which is of order k0 * eps / kappa per step."""
-    return model.k0 * max(2.0 * eps / model.kappa, 1e-3 * model.zbar)
+#: Peak-to-peak discretisation jitter of the stress, in units of k0 * eps (measured:
+#: the standard deviation of the stress in steady sliding is about 0.15 k0 eps for
+#: eps from 4e-3 to 1.6e-2 and k0 from 0.1 to 0.3, see docs/micro_numerics.md).
+JITTER = 1.0
+
+
+def _jitter(model: Model, eps: float) -> float:
+    """Peak-to-peak discretisation jitter of the stress: oscillations smaller than a
+    few times this are not resolved by the grid."""
+    return JITTER * model.k0 * eps
 
 
 def _time_scales(model: Model, V: float) -> tuple[float, float, float]:
@@ -249,7 +259,7 @@ def simulate(
     grid = _initial_grid(model, settings, first_v, initial)
     t0 = grid.t
     if record_dsigma is None:
-        record_dsigma = _stress_resolution(model, settings.eps)
+        record_dsigma = 0.25 * _jitter(model, settings.eps)
     if record_dt is None:
         record_dt = drive.duration / 2000.0
     start = time.perf_counter()
@@ -308,11 +318,13 @@ def stationary(
     t_max = convergence.t_max
     if t_max is None:
         t_max = max(400.0 * tau_u if math.isfinite(tau_u) else 0.0, 60.0 * tau_load)
-    resolution = _stress_resolution(model, settings.eps)
-    hysteresis = 4.0 * resolution
+    jitter = _jitter(model, settings.eps)
+    resolution = 0.25 * jitter  # records resolve the jitter...
+    hysteresis = 2.0 * jitter  # ...but only wiggles above it count as cycles
     span = max(tau_u if math.isfinite(tau_u) else 0.0, 20.0 * tau_c)  # one averaging span
     chunk = max(span, min(tau_load, 0.05 * t_max))
     s_inf = sigma_fast_limit(model)
+    n = convergence.n
 
     rec = Records.empty()
     shock_rows: list[np.ndarray] = []
@@ -329,30 +341,31 @@ def stationary(
         elapsed = t_now - t_begin
         # --- a converged limit cycle?
         cycles = find_cycles(rec, hysteresis)
-        if len(cycles) >= convergence.n and cycle_converged(cycles, convergence.rtol, convergence.atol, convergence.n):
-            last = cycles.iloc[-convergence.n:]
+        if len(cycles) >= n and cycle_converged(cycles, convergence.rtol, convergence.atol + jitter, n):
+            last = cycles.iloc[-n:]
             regime, converged = "stick-slip", True
-            message = f"limit cycle converged over {convergence.n} cycles"
+            message = f"limit cycle converged over {n} cycles"
             out = dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
-                       sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
+                       sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
+                       sigma_stderr=float(last.sigma_mean.std(ddof=1) / math.sqrt(n)))
             break
-        # --- a steady state?  Flat over the last n spans, with agreeing span means.
-        n = convergence.n
+        # --- a steady state?  No cycle in the last n spans, and span means that agree
+        # within the tolerance plus their own statistical error (the jitter).
         if elapsed >= (n + 1) * span:
-            recent = cycles[cycles.t_end > t_now - n * span] if len(cycles) else cycles
-            edges = [t_now - (n - i) * span for i in range(n + 1)]
-            means = [rec.time_mean(a, b) for a, b in zip(edges[:-1], edges[1:])]
-            lo = rec.since(edges[0])
-            amplitude = float(lo.sigma_max.max() - lo.sigma_min.min()) if len(lo) else math.inf
-            tol = convergence.rtol * abs(means[-1] - s_inf) + convergence.atol
-            if (len(recent) == 0 and amplitude <= 4.0 * hysteresis and np.all(np.isfinite(means))
-                    and max(means) - min(means) <= tol):
+            start = t_now - n * span
+            recent = cycles[cycles.t_end > start] if len(cycles) else cycles
+            means, errors = _span_means(rec, start, span, n)
+            tol = convergence.rtol * abs(float(np.mean(means)) - s_inf) + convergence.atol
+            agree = all(abs(means[i] - means[k]) <= tol + 2.0 * math.hypot(errors[i], errors[k])
+                        for i in range(n) for k in range(i + 1, n))
+            if len(recent) == 0 and np.all(np.isfinite(means)) and agree:
                 regime, converged = "steady", True
-                message = f"steady: {n} span means agree within {tol:.3g}"
+                message = f"steady: {n} span means agree within {tol:.3g} plus their statistical error"
                 sigma = float(np.mean(means))
-                out = dict(sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma, period=math.nan)
+                out = dict(sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma, period=math.nan,
+                           sigma_stderr=float(math.sqrt(np.sum(np.square(errors))) / n))
                 break
-        if elapsed >= t_max or code not in (K.DONE,):
+        if elapsed >= t_max or code != K.DONE:
             regime, message, out = _unconverged(rec, cycles, hysteresis, t_now, span, elapsed, t_max, code)
             break
         # lengthen the chunks while no cycle has shown up (slow stick-slip)
@@ -374,6 +387,20 @@ def stationary(
     if not converged:
         log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
     return result
+
+
+def _span_means(rec: Records, start: float, span: float, n: int, parts: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Time means of ``n`` consecutive spans from ``start``, and their standard errors
+    from ``parts`` sub-spans each."""
+    means = np.empty(n)
+    errors = np.empty(n)
+    for i in range(n):
+        a = start + i * span
+        sub = np.array([rec.time_mean(a + p * span / parts, a + (p + 1) * span / parts) for p in range(parts)])
+        sub = sub[np.isfinite(sub)]
+        means[i] = rec.time_mean(a, a + span)
+        errors[i] = float(np.std(sub, ddof=1) / math.sqrt(sub.size)) if sub.size > 2 else math.inf
+    return means, errors
 
 
 def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: float, span: float,
@@ -507,7 +534,7 @@ def slide_hold_slide(
     if resume is None:
         resume = 20.0 * tau_c + (2.0 * tau_u if math.isfinite(tau_u) else 0.0)
     settings = base.grid.settings
-    resolution = _stress_resolution(model, settings.eps)
+    resolution = 0.25 * _jitter(model, settings.eps)
     rows = []
     for h in holds:
         grid = base.grid.copy()
