@@ -352,9 +352,9 @@ def stationary(
         # --- a steady state?  No cycle in the last n spans, and span means that agree
         # within the tolerance plus their own statistical error (the jitter).
         if elapsed >= (n + 1) * span:
-            start = t_now - n * span
-            recent = cycles[cycles.t_end > start] if len(cycles) else cycles
-            means, errors = _span_means(rec, start, span, n)
+            t_from = t_now - n * span
+            recent = cycles[cycles.t_end > t_from] if len(cycles) else cycles
+            means, errors = _span_means(rec, t_from, span, n)
             tol = convergence.rtol * abs(float(np.mean(means)) - s_inf) + convergence.atol
             agree = all(abs(means[i] - means[k]) <= tol + 2.0 * math.hypot(errors[i], errors[k])
                         for i in range(n) for k in range(i + 1, n))
@@ -436,14 +436,17 @@ def critical_velocity(
     *,
     V_min: float = 1e-4,
     V_max: float = 1e3,
+    V_guess: float = 1.0,
+    factor: float = 8.0,
     rel_tol: float = 1e-2,
     numerics: Numerics | None = None,
     convergence: Convergence | None = None,
 ) -> Critical:
     """Critical velocity by bisection on the regime (the paper's Appendix B).
 
-    Starting from ``V_min`` (expected stick-slip) and ``V_max`` (expected steady), the
-    bracket is halved geometrically until ``V_high / V_low - 1 <= rel_tol``.  If the
+    The regime is evaluated at ``V_guess``, then at velocities ``factor`` times smaller
+    or larger (within ``[V_min, V_max]``) until it changes; the bracket is then halved
+    geometrically until ``V_high / V_low - 1 <= rel_tol``.  If the
     system is steady already at ``V_min`` (e.g. ``k0 >= k2``), ``Vc`` is reported as 0
     with status ``"no stick-slip"``; if it is stick-slip at ``V_max``, as ``inf`` with
     status ``"above range"``.
@@ -452,23 +455,53 @@ def critical_velocity(
     V_max = _check_velocity(V_max, "V_max")
     if not V_max > V_min:
         raise ValueError(f"V_max must be > V_min, got V_min={V_min!r}, V_max={V_max!r}")
+    V_guess = _check_velocity(V_guess, "V_guess")
+    if not (math.isfinite(factor) and factor > 1.0):
+        raise ValueError(f"factor must be a finite number > 1, got {factor!r}")
     if not (math.isfinite(rel_tol) and 0.0 < rel_tol < 1.0):
         raise ValueError(f"rel_tol must be in (0, 1), got {rel_tol!r}")
     evaluations: list[dict] = []
 
+    convergence = convergence or Convergence()
+
     def regime(V: float) -> str:
-        res = stationary(model, V, numerics=numerics, convergence=convergence)
+        conv = convergence
+        if conv.t_max is None:
+            # Only the regime is needed: near V^c the finite-eps dynamics is a noisy
+            # oscillation that never meets the stopping test, and its trend is clear
+            # well before the default t_max.
+            tau_u, _, tau_load = _time_scales(model, V)
+            t_max = max(100.0 * tau_u if math.isfinite(tau_u) else 0.0, 30.0 * tau_load)
+            conv = Convergence(rtol=conv.rtol, atol=conv.atol, n=conv.n, t_max=t_max)
+        res = stationary(model, V, numerics=numerics, convergence=conv)
         evaluations.append(res.to_dict())
         log.info("bisection k0=%g V=%.6g -> %s (%s)", model.k0, V, res.regime, res.message)
         return res.regime
 
-    if regime(V_max) != "steady":
-        return Critical(model, math.inf, V_max, math.inf, "above range",
-                        f"not steady at V_max = {V_max:g}", evaluations)
-    if regime(V_min) == "steady":
-        return Critical(model, 0.0, 0.0, V_min, "no stick-slip",
-                        f"steady already at V_min = {V_min:g}", evaluations)
-    lo, hi = V_min, V_max
+    # Bracket by expanding geometrically from V_guess: evaluations far from V^c are
+    # the expensive ones (cost grows like V at large V and like 1/V at small V).
+    V = min(max(V_guess, V_min), V_max)
+    steady = regime(V) == "steady"
+    lo, hi = (V_min, V) if steady else (V, V_max)
+    while True:
+        if steady:
+            if V <= V_min:
+                return Critical(model, 0.0, 0.0, V_min, "no stick-slip",
+                                f"steady already at V_min = {V_min:g}", evaluations)
+            V = max(V / factor, V_min)
+            if regime(V) != "steady":
+                lo = V
+                break
+            hi = V
+        else:
+            if V >= V_max:
+                return Critical(model, math.inf, V_max, math.inf, "above range",
+                                f"not steady at V_max = {V_max:g}", evaluations)
+            V = min(V * factor, V_max)
+            if regime(V) == "steady":
+                hi = V
+                break
+            lo = V
     while hi / lo - 1.0 > rel_tol:
         mid = math.sqrt(lo * hi)
         if regime(mid) == "steady":
