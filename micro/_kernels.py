@@ -66,7 +66,9 @@ F_WIN_INT = 18
 F_WIN_LEN = 19
 F_OWED = 20  # shift (bins) owed to the next step
 F_REC_SIGMA = 21  # stress at the last record
-N_FSTATE = 22
+F_LATE = 22  # mass found past the threshold at synchronisations (missed by the scan)
+F_YMEAN = 23  # exact mean delta_R = k2 <u>: it only relaxes, exp(-gamma t) (jumps keep u)
+N_FSTATE = 24
 
 # --- integer state -----------------------------------------------------------------
 I_OFF = 0  # column of d = 0
@@ -516,6 +518,7 @@ def synchronise(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_
     new_rlo = nrow
     new_rhi = 0
     sum_x = 0.0
+    sum_y = 0.0
     sum_m = 0.0
     neg = 0.0
     need = 0.5  # smallest safe 1 - lam until the next synchronisation
@@ -541,6 +544,7 @@ def synchronise(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_
             x = (k + 1 - phi - 0.5 * omega) * eps
             y = (j + eta) * eps + _correction(fst, prm, (j + eta) * eps, x)
             sum_x += m * x
+            sum_y += m * y
             sum_m += m
             u = y / eps
             jp = int(math.floor(u + 0.5))
@@ -585,7 +589,11 @@ def synchronise(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_
     fst[F_TREF] = fst[F_T]
     fst[F_HREF] = fst[F_HBAR]
     fst[F_LAM] = 1.0
-    fst[F_DRIFT] = 0.0
+    # <delta_R> relaxes exactly as exp(-gamma t) (<u> does, and jumps keep u); the
+    # binned landings of jumping mass miss that by O(eps^2) per jump, a bias that the
+    # relaxation alone would only bound at (jump rate) * eps^2 / gamma, i.e. growing
+    # with V.  Restore the invariant with a uniform offset carried by the drift term.
+    fst[F_DRIFT] = fst[F_YMEAN] - sum_y / sum_m
     # --- schedule: the next synchronisation comes before any cell's correction
     # (1 - lam) * pull can exceed SCAN - 2 bins, or P_THETA_R bins for a cell at the
     # threshold; mass that lands meanwhile pulls at most P_PULL_LAND bins.
@@ -713,7 +721,11 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, 
             return NEED_COLS
         a = ist[I_CUR]
         # --- synchronise when the stored positions are too stale
-        if gamma > 0.0 and (fst[F_LAM] <= fst[F_LAM_SYNC] or abs(fst[F_DRIFT]) > eps):
+        # (the uniform part of every cell's correction, drift minus the relaxation of the
+        # target's k2 * (hbar - hbar_a) term, is kept within one bin: at large V it grows
+        # like k2 V gamma t^2 / 2 and would otherwise carry cells past the scan window)
+        uniform = fst[F_DRIFT] - (1.0 - fst[F_LAM]) * prm[P_K2] * (fst[F_HBAR] - fst[F_HREF])
+        if gamma > 0.0 and (fst[F_LAM] <= fst[F_LAM_SYNC] or abs(uniform) > eps):
             rmin, rmax, cmax = bounds(ist, fst, prm, bufclo[a], bufchi[a])
             if rmin < 1 or rmax > nrow - 2:
                 return NEED_ROWS
@@ -730,6 +742,7 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, 
             ist[I_CUR] = b
             ist[I_SYNCS] += 1
             a = b
+            fst[F_LATE] += max(jumped, 0.0)
             fst[F_OWED] += _apply_jumps(fst, prm, max(jumped, 0.0), moment)
             if code != DONE:
                 return code
@@ -750,6 +763,7 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, 
         lam_step = math.exp(-gamma * dt)
         fst[F_DRIFT] = lam_step * fst[F_DRIFT] + prm[P_K2] * (fst[F_HBAR] - fst[F_HREF]) * (1.0 - lam_step)
         fst[F_LAM] *= lam_step
+        fst[F_YMEAN] *= lam_step
         # --- drive, then the cascade it triggers (the jumps happen at the end of the step)
         sigma_prev = fst[F_SIGMA]
         hbar_prev = fst[F_HBAR]

@@ -30,7 +30,7 @@ class GridSettings:
     Parameters
     ----------
     eps : bin width of delta_F and delta_R.  Must resolve a mean jump,
-        ``eps <= kappa * zbar / 4``.
+        ``kappa * zbar / 1000 <= eps <= kappa * zbar / 4``.
     theta_shift : largest shift of delta_F per time step, in bins (0 < theta_shift <= 1).
     theta_relax : how far (in bins) a cell near the threshold may relax between two
         synchronisations of the stored delta_R (the relaxation itself is exact; this
@@ -58,9 +58,11 @@ class GridSettings:
     def check(self, model: Model) -> None:
         """Check that ``eps`` resolves the model's mean jump ``kappa * zbar``."""
         limit = model.kappa * model.zbar / 4.0
-        if self.eps > limit:
+        floor = model.kappa * model.zbar / 1000.0
+        if not floor <= self.eps <= limit:
             raise ValueError(
-                f"eps must be <= kappa*zbar/4 = {limit:.4g} (4 bins per mean jump) for this model, got {self.eps!r}"
+                f"eps must be in [kappa*zbar/1000, kappa*zbar/4] = [{floor:.4g}, {limit:.4g}] for this model "
+                f"(at least 4 bins per mean jump; finer grids exceed memory and run time), got {self.eps!r}"
             )
 
 
@@ -134,6 +136,8 @@ class Grid:
         self.ist = np.zeros(K.N_ISTATE, dtype=np.int64)
         self.fst = np.zeros(K.N_FSTATE)
         self._build_initial(initial)
+        cells = self.cells()
+        self.fst[K.F_YMEAN] = float(np.sum(cells["mass"] * cells["delta_R"]) / np.sum(cells["mass"]))
 
     # ----------------------------------------------------------------------------- set-up
     def _allocate(self, nrow: int, ncol: int) -> None:

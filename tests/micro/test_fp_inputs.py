@@ -1,0 +1,93 @@
+"""Bad input to the Fokker-Planck solver fails at once, naming the parameter and its range."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import micro
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(k0=0.0), r"k0 must be"),
+        (dict(k0=-1.0), r"k0 must be"),
+        (dict(k0=math.nan), r"k0 must be"),
+        (dict(k0=0.1, k1=-0.1), r"k1 must be"),
+        (dict(k0=0.1, k2=math.inf), r"k2 must be"),
+        (dict(k0=0.1, eta_u=0.0), r"eta_u must be"),
+        (dict(k0=0.1, f_th=-1.0), r"f_th must be"),
+        (dict(k0=0.1, jumps=0.1), r"jumps must be a JumpDistribution"),
+    ],
+)
+def test_model_rejects_bad_parameters(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        micro.Model(**kwargs)
+
+
+@pytest.mark.parametrize(
+    "make, match",
+    [
+        (lambda: micro.Exponential(0.0), r"zbar"),
+        (lambda: micro.Exponential(0.1, cutoff=0.0), r"cutoff"),
+        (lambda: micro.Deterministic(-0.1), r"zbar"),
+        (lambda: micro.Tabulated(np.array([0.0, 1.0]), np.array([1.0, -1.0])), r"."),
+    ],
+)
+def test_jump_distributions_reject_bad_parameters(make, match):
+    with pytest.raises(ValueError, match=match):
+        make()
+
+
+@pytest.mark.parametrize(
+    "make, match",
+    [
+        (lambda: micro.Numerics(eps=0.0), r"eps must be"),
+        (lambda: micro.Numerics(eps=math.nan), r"eps must be"),
+        (lambda: micro.Numerics(theta_shift=1.5), r"theta_shift must be in \(0, 1\]"),
+        (lambda: micro.Numerics(theta_relax=0.0), r"theta_relax must be in \(0, 2\]"),
+        (lambda: micro.Convergence(rtol=0.0), r"rtol must be"),
+        (lambda: micro.Convergence(n=1), r"n must be an integer >= 2"),
+        (lambda: micro.Convergence(t_max=-1.0), r"t_max must be"),
+        (lambda: micro.Drive.schedule([]), r"segments"),
+        (lambda: micro.Drive.schedule([(1.0, -1.0)]), r"velocity must be"),
+        (lambda: micro.Drive.schedule([(0.0, 1.0)]), r"duration must be"),
+    ],
+)
+def test_numerics_and_protocols_reject_bad_parameters(make, match):
+    with pytest.raises(ValueError, match=match):
+        make()
+
+
+@pytest.mark.parametrize("eps", [0.05, 1e-5])
+def test_bin_outside_usable_range_is_rejected_with_the_range(eps):
+    model = micro.Model(k0=0.1)  # kappa * zbar = 0.11: eps in [1.1e-4, 2.75e-2]
+    with pytest.raises(ValueError, match=r"eps must be in \[kappa\*zbar/1000, kappa\*zbar/4\]"):
+        micro.stationary(model, 1.0, numerics=micro.Numerics(eps=eps))
+
+
+@pytest.mark.parametrize("V", [0.0, -1.0, math.inf, math.nan])
+def test_solvers_reject_bad_velocity(V):
+    model = micro.Model(k0=0.1)
+    with pytest.raises(ValueError, match=r"V must be a finite number > 0"):
+        micro.stationary(model, V)
+    with pytest.raises(ValueError, match=r"V must be a finite number > 0"):
+        micro.slide_hold_slide(model, V, [1.0])
+
+
+def test_critical_velocity_rejects_bad_bracket():
+    model = micro.Model(k0=0.1)
+    with pytest.raises(ValueError, match=r"V_max must be > V_min"):
+        micro.critical_velocity(model, V_min=1.0, V_max=0.5)
+    with pytest.raises(ValueError, match=r"rel_tol must be in \(0, 1\)"):
+        micro.critical_velocity(model, rel_tol=0.0)
+    with pytest.raises(ValueError, match=r"factor must be"):
+        micro.critical_velocity(model, factor=1.0)
+
+
+def test_hold_times_must_be_nonnegative():
+    model = micro.Model(k0=1.0)
+    with pytest.raises(ValueError, match=r"hold times must be finite numbers >= 0"):
+        micro.slide_hold_slide(model, 5.0, [1.0, -2.0], numerics=micro.Numerics(eps=0.02))

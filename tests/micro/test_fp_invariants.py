@@ -1,0 +1,79 @@
+"""Exact properties of the Fokker-Planck solver: conserved probability, non-negative
+density, a stress that only falls while the drive holds still, and the renewal limit
+(k2 = 0), where the stationary stress is known in closed form for any g."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import micro
+
+FAST = micro.Numerics(eps=0.016)
+
+
+@pytest.fixture(scope="module")
+def slide_hold_slide_run():
+    # stick-slip at V = 0.05 (global shocks), a hold, then steady sliding at V = 2
+    model = micro.Model(k0=0.1)
+    drive = micro.Drive.schedule([(60.0, 0.05), (20.0, 0.0), (5.0, 2.0)])
+    return micro.simulate(model, drive, numerics=FAST)
+
+
+def test_probability_is_conserved_and_non_negative(slide_hold_slide_run):
+    run = slide_hold_slide_run
+    assert len(run.shocks) >= 3  # the run went through global shocks
+    assert run.mass_error < 1e-12
+    assert run.min_mass >= -1e-15
+    M, eta, omega = run.grid.density()
+    assert np.all(np.isfinite(M)) and M.min() >= -1e-15
+    assert np.all(np.isfinite(eta))
+    held = M > 1e-14  # fractions of round-off masses carry no meaning
+    assert np.all((omega[held] > 0.0) & (omega[held] <= 1.0 + 1e-12))
+
+
+def test_records_follow_the_drive(slide_hold_slide_run):
+    rec = slide_hold_slide_run.records
+    assert np.all(np.isfinite(rec[["t", "w", "sigma"]].to_numpy()))
+    assert np.all(np.diff(rec.t) >= 0.0) and np.all(np.diff(rec.w) >= -1e-12)
+    # w = integral of the drive velocity
+    w_expected = np.interp(rec.t, [0.0, 60.0, 80.0, 85.0], [0.0, 3.0, 3.0, 13.0])
+    np.testing.assert_allclose(rec.w, w_expected, atol=1e-9)
+    assert rec.t.iloc[-1] == pytest.approx(85.0)
+
+
+def test_stress_never_rises_while_the_drive_holds(slide_hold_slide_run):
+    # sigma = k0 (w - hbar) and blocks only jump forward: with w fixed sigma cannot rise
+    rec = slide_hold_slide_run.records
+    hold = rec[(rec.t > 60.0 + 1e-9) & (rec.t < 80.0 - 1e-9)]
+    assert len(hold) > 5
+    assert np.all(np.diff(hold.sigma) <= 1e-12)
+
+
+def test_stress_jumps_are_the_shock_drops(slide_hold_slide_run):
+    shocks = slide_hold_slide_run.shocks
+    assert np.all(shocks.sigma_after < shocks.sigma_before)
+    assert np.all(shocks["shift"] > 0.0)
+
+
+@pytest.mark.parametrize("V", [0.1, 10.0])
+def test_renewal_limit_without_dashpots(V):
+    # k2 = 0: each delta is a renewal process with increments kappa z, so the stationary
+    # stress is f_th - kappa <z^2> / (2 <z>) at every V (no viscoelastic weakening).
+    # (Exponential g: deterministic jumps coupled by k1 synchronise instead.)
+    model = micro.Model(k0=0.5, k1=0.5, k2=0.0, jumps=micro.Exponential(0.1))
+    exact = micro.sigma_fast_limit(model)
+    errors = []
+    for eps in (0.02, 0.01):
+        res = micro.stationary(model, V, numerics=micro.Numerics(eps=eps))
+        assert res.converged and res.regime == "steady", res.message
+        assert res.mass_error < 1e-12 and res.min_mass >= -1e-15
+        errors.append(abs(res.sigma_mean - exact))
+    assert errors[1] < 1e-4
+    assert errors[1] < 0.5 * errors[0]  # converges as eps shrinks
+    assert res.mass_error < 1e-12 and res.min_mass >= -1e-15
+
+
+def test_results_report_their_density_checks():
+    res = micro.stationary(micro.Model(k0=0.3), 3.0, numerics=FAST)
+    row = res.to_dict()
+    assert row["mass_error"] < 1e-12 and row["min_mass"] >= -1e-15
