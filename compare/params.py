@@ -61,6 +61,12 @@ class Settings:
         bisected); ``phase_rel_tol``: bisection tolerance; ``phase_eps``: its bin;
         ``phase_reference_V``: velocities of each set's reference steady branch (the RS law
         of that set is fitted to it).
+    critical_k0, critical_rel_tol : k0 whose micro Vc is bisected (at ``eps``) for the
+        table of critical velocities, and the bisection tolerance; the other k0 get the
+        bracket of their diagram points.
+    rs_points : velocities per k0 of the RS bifurcation curves.
+    classical_b : b of the classical RS law, Eq. (7) (raised to 1.5 W(V) if smaller, so
+        that a = b - W(V) > 0).
     shs_k0, shs_V, hold_times : slide-hold-slide (Fig. 7): stiffness, drive velocity (must
         be steady) and hold times.
     """
@@ -70,27 +76,31 @@ class Settings:
     k2: float = 0.9
     zbar: float = 0.1
     cutoff: float = 10.0
-    eps: float = 0.008
+    eps: float = 0.016
     rtol: float = 1e-2
     atol: float = 1e-4
     t_max: float | None = None
-    diagram_ratios: tuple[float, ...] = (0.05, 0.2, 0.5, 0.8, 1.2, 2.0, 4.0)
+    diagram_ratios: tuple[float, ...] = (0.05, 0.2, 0.5, 0.75, 2.0, 4.0)
     reference_k0: float = 1.0
-    reference_V: tuple[float, ...] = (0.01, 0.03, 0.1, 0.3, 1.0, 3.0)
+    reference_V: tuple[float, ...] = (0.03, 0.1, 0.3, 1.0, 3.0)
     dc_bounds: tuple[float, float] = (0.005, 0.5)
     dc_grid: int = 41
     bootstrap: int = 400
+    critical_k0: tuple[float, ...] = (0.3, 0.1)
+    critical_rel_tol: float = 0.05
+    rs_points: int = 50
     hopf_k0: float = 0.1
-    hopf_distances: tuple[float, ...] = (0.03, 0.1, 0.2, 0.4, 0.6)
-    hopf_rel_tol: float = 0.02
+    hopf_distances: tuple[float, ...] = (0.1, 0.2, 0.35, 0.5, 0.7)
+    hopf_rel_tol: float = 0.05
     phase_sets: tuple[tuple[float, float], ...] = PAPER_SETS
-    phase_k0: tuple[float, ...] = (0.3, 0.03)
-    phase_rel_tol: float = 0.1
-    phase_eps: float = 0.016
-    phase_reference_V: tuple[float, ...] = (0.03, 0.3, 3.0)
+    phase_k0: tuple[float, ...] = (0.3, 0.05)
+    phase_rel_tol: float = 0.2
+    phase_eps: float = 0.02
+    phase_reference_V: tuple[float, ...] = (0.05, 0.15, 0.5, 3.0)
     shs_k0: float = 0.1
     shs_V: float = 10.0
     hold_times: tuple[float, ...] = (0.1, 0.3, 1.0, 2.0, 4.0, 8.0, 16.0)
+    classical_b: float = 0.01
     scenarios: tuple[str, ...] = SCENARIOS
     preset: str = "default"
 
@@ -118,6 +128,12 @@ class Settings:
         set_("dc_bounds", (lo, hi))
         set_("dc_grid", positive_int("dc_grid", self.dc_grid, low=7))
         set_("bootstrap", positive_int("bootstrap", self.bootstrap, low=0))
+        set_("critical_k0", tuple(sorted(positive_array("critical_k0", self.critical_k0, low=0.0, high=10.0, min_size=0),
+                                         reverse=True)))
+        set_("critical_rel_tol", in_range("critical_rel_tol", self.critical_rel_tol, 0.0, 1.0, low_open=True,
+                                          high_open=True))
+        set_("rs_points", positive_int("rs_points", self.rs_points, low=5))
+        set_("classical_b", positive("classical_b", self.classical_b))
         set_("hopf_k0", positive("hopf_k0", self.hopf_k0))
         set_("hopf_distances", tuple(sorted(positive_array("hopf_distances", self.hopf_distances,
                                                            low=0.0, high=1.0, min_size=3))))
@@ -151,10 +167,11 @@ class Settings:
     def quick(cls, **changes: Any) -> Settings:
         """A smoke run (tens of seconds): few points, a coarse bin.  Its numbers only show
         that the pipeline works."""
-        base = cls(k0=(0.1,), eps=0.02, diagram_ratios=(0.2, 0.6, 1.5, 3.0), reference_V=(0.03, 0.3, 3.0),
-                   dc_grid=13, bootstrap=50, hopf_distances=(0.1, 0.3, 0.6), hopf_rel_tol=0.1,
-                   phase_sets=((0.1, 0.9),), phase_k0=(0.3,), phase_rel_tol=0.3, phase_eps=0.02,
-                   phase_reference_V=(0.03, 0.3, 3.0), shs_V=3.0, hold_times=(0.3, 1.0, 3.0, 10.0),
+        base = cls(k0=(0.3,), eps=0.025, diagram_ratios=(0.3, 0.6, 3.0, 6.0), reference_V=(0.1, 0.3, 1.0, 3.0),
+                   dc_grid=13, bootstrap=50, critical_k0=(0.3,), critical_rel_tol=0.3, rs_points=12,
+                   hopf_k0=0.3, hopf_distances=(0.2, 0.4, 0.6, 0.8), hopf_rel_tol=0.3,
+                   phase_sets=((0.5, 0.5),), phase_k0=(0.3,), phase_rel_tol=0.3, phase_eps=0.025,
+                   phase_reference_V=(0.1, 0.3, 1.0, 3.0), shs_k0=0.3, shs_V=3.0, hold_times=(0.3, 1.0, 3.0, 10.0),
                    preset="quick")
         return replace(base, **changes) if changes else base
 
