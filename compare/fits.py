@@ -20,7 +20,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import curve_fit, least_squares, minimize_scalar
+from scipy.optimize import brentq, curve_fit, least_squares, minimize_scalar
 
 import rsf
 
@@ -361,15 +361,26 @@ def fit_dc(frame: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateLaw], 
     rss_min = float(r_opt @ r_opt)
     if i in (0, len(grid) - 1):
         log.warning("fit_dc: the optimum D_c = %.4g sits at the bound of %s", Dc, bounds)
-    # profile interval
+    # profile interval: where RSS(D_c) <= level, located by root finding on each side of the
+    # optimum (the grid alone cannot resolve a sharp minimum)
     level = rss_min * (1.0 + 1.0 / max(n - 1, 1))
-    below = np.flatnonzero(rss_grid <= level)
     log_grid = np.log(grid)
-    if below.size:
-        prof = (_crossing(log_grid, rss_grid, level, below.min(), -1), _crossing(log_grid, rss_grid, level, below.max(), +1))
-    else:  # the grid minimum is above the level (the optimum lies between grid values)
-        prof = (_crossing(log_grid, rss_grid, level, i, -1), _crossing(log_grid, rss_grid, level, i, +1))
-    profile_interval = (float(math.exp(prof[0])), float(math.exp(prof[1])))
+    rss_of = lambda g: float(np.sum(residuals(math.exp(g))[0] ** 2)) - level  # noqa: E731
+    g_opt = math.log(Dc)
+    ends = []
+    for direction in (-1, +1):
+        j = i
+        while 0 <= j < len(grid) and (rss_grid[j] <= level or (log_grid[j] - g_opt) * direction <= 0):
+            j += direction
+        if not 0 <= j < len(grid):
+            ends.append(float(grid[0] if direction < 0 else grid[-1]))   # open at the search bound
+            continue
+        a, b = sorted((g_opt, float(log_grid[j])))
+        try:
+            ends.append(math.exp(brentq(rss_of, a, b, xtol=1e-6)))
+        except ValueError:  # no sign change (level reached at the optimum itself)
+            ends.append(Dc)
+    profile_interval = (float(ends[0]), float(ends[1]))
     # bootstrap over points
     rng = np.random.default_rng(seed)
     boot = np.empty(int(n_bootstrap))
@@ -398,19 +409,6 @@ def fit_dc(frame: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateLaw], 
     return DcFit(Dc=Dc, Dc_err=Dc_err, Dc_profile=profile_interval, Dc_bootstrap=(q16, q84),
                  rms=math.sqrt(rss_min / (2 * n)), rms_per_k0=per_k0, profile=profile, points=out,
                  n_points=n, regime_agreement=agree, bootstrap=boot)
-
-
-def _crossing(x: np.ndarray, y: np.ndarray, level: float, start: int, direction: int) -> float:
-    """Where y crosses ``level`` walking from ``start`` in ``direction`` (linear
-    interpolation); the grid end if it never does."""
-    j = start
-    while 0 <= j + direction < len(x):
-        if y[j + direction] > level:
-            y0, y1 = y[j], y[j + direction]
-            f = (level - y0) / (y1 - y0) if y1 != y0 else 0.0
-            return float(x[j] + f * (x[j + direction] - x[j]))
-        j += direction
-    return float(x[j])
 
 
 def _parabolic_min(x: np.ndarray, y: np.ndarray) -> float:
