@@ -464,7 +464,7 @@ def fit_power_law(V, amplitude, *, Vc: float | None = None) -> PowerLawFit:
     if Vc is not None:
         Vc = positive("Vc", Vc)
         if np.any(V >= Vc):
-            raise ValueError(f"every V must be < Vc = {Vc!r}")
+            raise ValueError(f"Vc must be > every V (largest V = {float(V.max())!r}), got {Vc!r}")
         x, y = np.log(Vc - V), np.log(amp)
         X = np.column_stack([np.ones_like(x), x])
         coef, *_ = np.linalg.lstsq(X, y, rcond=None)

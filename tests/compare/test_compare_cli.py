@@ -36,12 +36,15 @@ def test_bad_option_value_is_a_clear_error(tmp_path):
 
 
 def test_shs_scenario_end_to_end(tmp_path):
-    """One scenario computes only what its figure needs (one micro task; D_c given)."""
+    """One scenario computes only what its figure needs: the slide-hold-slide run and the
+    Eq. (10) law (from the micro steady points); with D_c given, no D_c fit, no other figure."""
     out = tmp_path / "report"
     proc = _run(["--quick", "--scenario", "shs", "--dc", "0.06", "--out", str(out)], tmp_path / "cache", 300)
     assert proc.returncode == 0, proc.stderr
     assert (out / "shs.png").stat().st_size > 10_000
-    assert not (out / "bifurcation.png").exists() and not (out / "micro_points.csv").exists()
+    for other in ("bifurcation.png", "hopf.png", "phase.png", "dc_fit.csv", "rs_bifurcation.csv",
+                  "critical_velocity.csv", "phase_micro.csv"):
+        assert not (out / other).exists(), other
     fit = pd.read_csv(out / "shs_fit.csv")
     best = fit[fit.best].set_index("model").law.to_dict()
     # each model's peak follows its own growth law best (paper Sec. IV/V)
