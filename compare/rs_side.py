@@ -1,0 +1,129 @@
+r"""The rate-and-state side of the comparison, on top of :mod:`rsf` (fast, not cached).
+
+* :func:`rs_curves` — σ_max, σ_min of the RS attractor on a dense V grid per k0.
+* :func:`rs_hopf` — amplitudes at :math:`V = V^c(1 - d)` for given relative distances d.
+* :func:`rs_slide_hold_slide` — the peak after a hold, for any :class:`rsf.SpringSlider`
+  (Eq. 11 with a = 0, or the classical Eq. 7 with a direct effect).
+* :func:`classical_rs` — Eq. (7) with the same local velocity weakening as a given
+  steady law at V: :math:`b - a = W(V)`.
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable, Sequence
+
+import numpy as np
+import pandas as pd
+
+import rsf
+
+from ._validation import positive
+
+__all__ = ["rs_curves", "rs_hopf", "rs_slide_hold_slide", "classical_rs", "DEFAULT_OPTIONS"]
+
+#: Limit cycles to 1e-7 (relative), CVODE rtol 1e-8: far below the micro errors.
+DEFAULT_OPTIONS = rsf.SolverOptions(cycle_rtol=1e-7, rtol=1e-8)
+
+
+def rs_curves(k0s: Sequence[float], law_for: Callable[[float], rsf.SteadyStateLaw], Dc: float, *,
+              V_range: Callable[[float], tuple[float, float]], n: int = 80,
+              options: rsf.SolverOptions | None = None, label: str = "") -> pd.DataFrame:
+    """RS attractors on ``n`` log-spaced velocities per k0 (``V_range(k0)`` gives the ends).
+
+    Returns ``k0, V, regime, sigma_max, sigma_min, sigma_mean, converged, Dc, label``.
+    """
+    options = options or DEFAULT_OPTIONS
+    frames = []
+    for k0 in k0s:
+        lo, hi = V_range(k0)
+        model = rsf.SpringSlider(law=law_for(k0), k0=k0, Dc=Dc)
+        Vs = np.geomspace(lo, hi, int(n))
+        cv = rsf.critical_velocity(model)
+        if math.isfinite(cv.Vc) and lo < cv.Vc < hi:   # resolve the bifurcation point itself
+            Vs = np.union1d(Vs, cv.Vc * (1.0 - np.array([1e-2, 3e-3, 1e-3, 1e-4])))
+            Vs = np.union1d(Vs, [cv.Vc * (1.0 + 1e-4)])
+        if math.isfinite(cv.V_lower) and lo < cv.V_lower < hi:
+            Vs = np.union1d(Vs, cv.V_lower * np.array([1.0 - 1e-4, 1.0 + 1e-4]))
+        frame = rsf.sweep(model, Vs, options=options).to_frame()
+        frame["k0"] = k0
+        frames.append(frame[["k0", "V", "regime", "sigma_max", "sigma_min", "sigma_mean", "converged"]])
+    out = pd.concat(frames, ignore_index=True)
+    out["Dc"] = Dc
+    out["label"] = label
+    return out
+
+
+def rs_hopf(model: rsf.SpringSlider, distances: Sequence[float], *,
+            options: rsf.SolverOptions | None = None) -> pd.DataFrame:
+    """Limit cycles at :math:`V = V^c (1 - d)`; columns ``d, V, Vc, amplitude, sigma_max,
+    sigma_min, regime, converged``."""
+    cv = rsf.critical_velocity(model)
+    if not (math.isfinite(cv.Vc) and cv.Vc > 0):
+        raise ValueError(f"no finite RS critical velocity for k0 = {model.k0!r}, Dc = {model.Dc!r}")
+    options = options or rsf.SolverOptions(cycle_rtol=1e-10, rtol=1e-11, atol=1e-13)
+    rows = []
+    for d in distances:
+        d = float(d)
+        if not 0.0 < d < 1.0:
+            raise ValueError(f"distances must lie in (0, 1), got {d!r}")
+        V = cv.Vc * (1.0 - d)
+        r = rsf.limit_cycle(model, V, options=options)
+        rows.append({"d": d, "V": V, "Vc": cv.Vc, "amplitude": r.sigma_max - r.sigma_min,
+                     "sigma_max": r.sigma_max, "sigma_min": r.sigma_min, "regime": r.regime,
+                     "converged": r.converged})
+    return pd.DataFrame(rows)
+
+
+def rs_slide_hold_slide(model: rsf.SpringSlider, V: float, hold_times: Sequence[float], *,
+                        options: rsf.SolverOptions | None = None) -> pd.DataFrame:
+    r"""Peak stress after a hold, starting from steady sliding at ``V``.
+
+    For each hold: slide for :math:`D_c/V` from the exact steady state, stop the drive for
+    the hold, reload at V; the peak is the largest σ after the reload starts (a stick end
+    on the threshold for a = 0, the σ-maximum event for a > 0).  Returns ``hold_time,
+    sigma_steady, sigma_peak, delta_sigma_max, status`` per hold.
+    """
+    V = positive("V", V)
+    options = options or rsf.SolverOptions(rtol=1e-9)
+    sigma_ss = model.sigma_steady(V)
+    slide = model.Dc / V
+    rows = []
+    for h in hold_times:
+        h = positive("hold_time", h)
+        # reload until well past the peak: the stick needs (peak - sigma_ss)/(k0 V); the
+        # peak is below sup(mu_ss) (Eq. 10) or ~ b ln(1 + h V/Dc) (Eq. 7)
+        law = model.law
+        if isinstance(law, rsf.LogLaw):
+            gain = law.b * math.log1p(h * V / model.Dc) + law.a * 10.0
+        else:
+            gain = float(np.max(law.mu_ss(np.array([1e-12])))) - sigma_ss
+        reload = 4.0 * max(gain, 1e-6) / (model.k0 * V) + 200.0 * model.Dc / V
+        protocol = rsf.Protocol.slide_hold_slide(V, slide, h)
+        run = rsf.simulate(model, protocol=protocol, t_end=slide + h + reload,
+                           initial=rsf.InitialState(perturbation=0.0), options=options)
+        after = run.t >= slide + h
+        peak = float(np.max(run.sigma[after])) if np.any(after) else math.nan
+        ev = run.events_frame()
+        ev = ev[ev.t >= slide + h]
+        if len(ev):
+            peak = max(peak, float(ev.sigma.max()))
+        rows.append({"hold_time": h, "sigma_steady": sigma_ss, "sigma_peak": peak,
+                     "delta_sigma_max": peak - sigma_ss, "status": run.status})
+    return pd.DataFrame(rows)
+
+
+def classical_rs(law: rsf.SteadyStateLaw, V: float, b: float, k0: float, Dc: float) -> rsf.SpringSlider:
+    r"""The classical RS spring-slider, Eq. (7), tangent to ``law`` at ``V``:
+
+    .. math:: \mu = \mu_0 + a\ln(v/V) + b\ln(\theta V/D_c),\qquad \mu_0 = \mu_{ss}(V),\quad
+              b - a = W(V) = -V\,\mu_{ss}'(V),
+
+    so that its steady friction and its velocity weakening at V equal those of ``law``;
+    ``b`` (> W(V)) is the one free constant.
+    """
+    V, b = positive("V", V), positive("b", b)
+    W = float(law.weakening(np.array([V]))[0])
+    if not b > W:
+        raise ValueError(f"b must be > W(V) = {W!r} so that a = b - W(V) > 0, got {b!r}")
+    mu0 = float(law.mu_ss(np.array([V]))[0])
+    return rsf.SpringSlider(law=rsf.LogLaw(mu0=mu0, a=b - W, b=b, v0=V), k0=k0, Dc=Dc)

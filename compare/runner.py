@@ -1,0 +1,223 @@
+"""Run many micro tasks: from the disk cache when possible, else in parallel.
+
+:class:`Runner` takes a list of tasks (:mod:`compare.tasks`) and returns their records
+in the same order.  Records already in the cache are returned at once; the others are
+computed
+
+* in this process when ``workers == 1`` (no pool; what the tests compare against),
+* on a local process pool by default (``workers`` processes, ``spawn`` start method; the
+  numba kernels are compiled once in the parent first so that every worker only loads
+  them from numba's disk cache),
+* on a dask.distributed cluster when ``scheduler`` is an address such as
+  ``tcp://10.0.0.5:8786`` (or a ``distributed.Client``).  The workers need ``micro`` and
+  ``compare`` importable; results come back to this process, which alone writes the
+  cache, so the workers need no shared file system.
+
+Each record is written to the cache as soon as it arrives (atomically), so an
+interrupted sweep loses only the points that were running.  A progress bar (tqdm) counts
+the points, cached ones included.
+"""
+from __future__ import annotations
+
+import logging
+import multiprocessing
+import os
+import time
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass, field
+from typing import Any, Iterable, Sequence
+
+from tqdm.auto import tqdm
+
+from ._validation import positive_int
+from .cache import NullCache, PointCache
+from .tasks import Task, execute, warm_up
+
+__all__ = ["Runner", "RunStats"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class RunStats:
+    """What a runner did: tasks asked for, served from the cache, computed, failed, and the
+    summed compute time of the computed ones."""
+
+    requested: int = 0
+    cached: int = 0
+    computed: int = 0
+    failed: int = 0
+    compute_seconds: float = 0.0
+    warm_up_seconds: float = 0.0
+    slowest: list[tuple[float, str]] = field(default_factory=list)
+
+    def add(self, record: dict[str, Any], label: str) -> None:
+        self.computed += 1
+        self.compute_seconds += float(record.get("wall_time", 0.0))
+        if record.get("status") != "ok":
+            self.failed += 1
+        self.slowest.append((float(record.get("wall_time", 0.0)), label))
+        self.slowest.sort(reverse=True)
+        del self.slowest[5:]
+
+
+def _worker_init() -> None:
+    logging.basicConfig(level=logging.WARNING)
+    warm_up()
+
+
+class Runner:
+    """Cached, parallel execution of tasks.
+
+    Parameters
+    ----------
+    cache : PointCache, NullCache or None
+        Where records live; None means a :class:`PointCache` in the default directory.
+    workers : int or None
+        Local processes (None: ``os.cpu_count()``); 1 runs the tasks in this process.
+        Ignored when ``scheduler`` is given.
+    scheduler : str or distributed.Client or None
+        Address of a dask.distributed scheduler (needs the optional ``dask`` extra).
+    progress : bool
+        Show a progress bar.
+
+    Use it as a context manager (or call :meth:`close`) to shut the pool down.
+    """
+
+    def __init__(self, cache: PointCache | NullCache | None = None, *, workers: int | None = None,
+                 scheduler: Any = None, progress: bool = True) -> None:
+        self.cache = PointCache() if cache is None else cache
+        if not isinstance(self.cache, (PointCache, NullCache)):
+            raise ValueError(f"cache must be a PointCache or NullCache, got {type(self.cache).__name__}")
+        self.workers = (os.cpu_count() or 1) if workers is None else positive_int("workers", workers)
+        if scheduler is not None and not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
+            raise ValueError(f"scheduler must be an address like 'tcp://host:8786' or a distributed.Client, "
+                             f"got {scheduler!r}")
+        self.scheduler = scheduler
+        self.progress = bool(progress)
+        self.stats = RunStats()
+        self._pool: ProcessPoolExecutor | None = None
+        self._client = None
+        self._own_client = False
+        self._warm = False
+
+    # -- life cycle ------------------------------------------------------------------------
+    def __enter__(self) -> Runner:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+        if self._client is not None and self._own_client:
+            self._client.close()
+        self._client = None
+
+    @property
+    def mode(self) -> str:
+        if self.scheduler is not None:
+            return f"dask ({self.scheduler if isinstance(self.scheduler, str) else 'client'})"
+        return "serial" if self.workers == 1 else f"process pool ({self.workers} workers)"
+
+    # -- running ---------------------------------------------------------------------------
+    def run(self, tasks: Sequence[Task], *, desc: str = "micro points") -> list[dict[str, Any]]:
+        """Records of ``tasks`` in their order (duplicates are computed once)."""
+        tasks = list(tasks)
+        keys = [t.key for t in tasks]
+        records: dict[str, dict[str, Any]] = {}
+        todo: list[Task] = []
+        queued: set[str] = set()
+        for key, task in zip(keys, tasks):
+            if key in records or key in queued:
+                continue
+            rec = self.cache.get(key)
+            if rec is not None:
+                records[key] = rec
+            else:
+                todo.append(task)
+                queued.add(key)
+        n_unique = len(records) + len(todo)
+        self.stats.requested += n_unique
+        self.stats.cached += len(records)
+        log.info("%s: %d points, %d from the cache, %d to compute (%s)", desc, n_unique, len(records),
+                 len(todo), self.mode if todo else "nothing to run")
+        bar = tqdm(total=n_unique, initial=len(records), desc=desc, unit="pt", disable=not self.progress,
+                   dynamic_ncols=True, leave=True)
+        try:
+            if todo:
+                for rec in self._compute(todo):
+                    self._store(rec)
+                    records[rec["key"]] = rec
+                    bar.update(1)
+        finally:
+            bar.close()
+        return [records[k] for k in keys]
+
+    def _store(self, record: dict[str, Any]) -> None:
+        task = record.get("task", {})
+        label = f"{task.get('kind')} {task.get('model', {}).get('k0')} {task.get('V', '')}"
+        self.stats.add(record, label)
+        if record.get("status") != "ok":
+            log.warning("micro point failed: %s: %s", label, record.get("error"))
+        if record.get("cacheable"):
+            self.cache.put(record["key"], record)
+
+    def _ensure_warm(self) -> None:
+        if not self._warm:
+            seconds = warm_up()
+            self.stats.warm_up_seconds += seconds
+            log.info("micro kernels ready in this process after %.1f s", seconds)
+            self._warm = True
+
+    def _compute(self, todo: list[Task]) -> Iterable[dict[str, Any]]:
+        if self.scheduler is not None:
+            yield from self._compute_dask(todo)
+        elif self.workers == 1 or len(todo) == 1:
+            self._ensure_warm()
+            for task in todo:
+                yield execute(task)
+        else:
+            yield from self._compute_pool(todo)
+
+    def _compute_pool(self, todo: list[Task]) -> Iterable[dict[str, Any]]:
+        if self._pool is None:
+            self._ensure_warm()  # compile once here; workers then load numba's disk cache
+            self._pool = ProcessPoolExecutor(max_workers=self.workers,
+                                             mp_context=multiprocessing.get_context("spawn"),
+                                             initializer=_worker_init)
+        pending: set[Future] = {self._pool.submit(execute, task) for task in todo}
+        try:
+            while pending:
+                done, pending = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    yield fut.result()
+        except BaseException:
+            for fut in pending:
+                fut.cancel()
+            raise
+
+    def _compute_dask(self, todo: list[Task]) -> Iterable[dict[str, Any]]:
+        try:
+            from distributed import Client, as_completed
+        except ImportError as exc:  # pragma: no cover - depends on the environment
+            raise ImportError("a dask scheduler needs the optional dependency: pip install 'dask[distributed]' "
+                              "(or this project's 'dask' extra)") from exc
+        if self._client is None:
+            if isinstance(self.scheduler, str):
+                self._client = Client(self.scheduler, timeout="30s")
+                self._own_client = True
+            else:
+                self._client = self.scheduler
+            start = time.perf_counter()
+            self._client.run(warm_up)
+            self.stats.warm_up_seconds += time.perf_counter() - start
+        futures = self._client.map(execute, todo, pure=False)
+        try:
+            for fut in as_completed(futures):
+                yield fut.result()
+        except BaseException:
+            self._client.cancel(futures)
+            raise

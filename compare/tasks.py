@@ -1,0 +1,250 @@
+"""Units of micro work that the runner schedules, caches and runs in parallel.
+
+A task is a small frozen dataclass that holds everything its result depends on (the
+model, the drive velocity, the numerics, the stopping rule) and can say so as canonical
+JSON (:meth:`describe`).  Its cache key is the SHA-256 of that description together with
+the *code version*: a hash of the source of the ``micro`` package and of this module's
+format number, so that a change of the solver never serves stale numbers.
+
+Tasks are picklable (plain fields), so that they travel to process-pool workers and to
+dask workers unchanged.  :func:`execute` runs one and returns a JSON-serialisable record;
+it never raises for an error of the computation itself: the record says what happened.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import math
+import time
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import micro
+
+from ._validation import in_range, positive
+
+__all__ = [
+    "StationaryTask",
+    "CriticalTask",
+    "SlideHoldSlideTask",
+    "Task",
+    "execute",
+    "code_version",
+    "model_description",
+    "model_from_description",
+    "warm_up",
+]
+
+log = logging.getLogger(__name__)
+
+#: Bump when the meaning or layout of a task's record changes.
+TASK_FORMAT = 1
+
+
+@lru_cache(maxsize=1)
+def code_version() -> str:
+    """SHA-256 (first 16 hex digits) of the ``micro`` sources and :data:`TASK_FORMAT`."""
+    digest = hashlib.sha256(f"compare-task-format-{TASK_FORMAT}".encode())
+    root = Path(micro.__file__).resolve().parent
+    for path in sorted(root.glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def model_description(model: micro.Model) -> dict[str, Any]:
+    """The model as a canonical dict (every parameter that changes its results)."""
+    if not isinstance(model, micro.Model):
+        raise ValueError(f"model must be a micro.Model, got {type(model).__name__}")
+    jumps = model.jumps
+    if isinstance(jumps, micro.Exponential):
+        jd = {"type": "Exponential", "zbar": float(jumps.zbar), "cutoff": float(jumps.cutoff)}
+    elif isinstance(jumps, micro.Deterministic):
+        jd = {"type": "Deterministic", "zbar": float(jumps.zbar)}
+    else:
+        raise ValueError("model.jumps must be micro.Exponential or micro.Deterministic for cached "
+                         f"comparisons (a Tabulated density cannot be hashed), got {type(jumps).__name__}")
+    return {"k0": float(model.k0), "k1": float(model.k1), "k2": float(model.k2),
+            "eta_u": float(model.eta_u), "f_th": float(model.f_th), "jumps": jd}
+
+
+def model_from_description(d: dict[str, Any]) -> micro.Model:
+    """Inverse of :func:`model_description`."""
+    jd = dict(d["jumps"])
+    kind = jd.pop("type")
+    jumps = micro.Exponential(**jd) if kind == "Exponential" else micro.Deterministic(**jd)
+    return micro.Model(k0=d["k0"], k1=d["k1"], k2=d["k2"], eta_u=d["eta_u"], f_th=d["f_th"], jumps=jumps)
+
+
+def _numerics_description(numerics: micro.Numerics, model: micro.Model) -> dict[str, Any]:
+    eps = micro.default_eps(model) if numerics.eps is None else float(numerics.eps)
+    return {"eps": eps, "theta_shift": float(numerics.theta_shift), "theta_relax": float(numerics.theta_relax)}
+
+
+def _convergence_description(conv: micro.Convergence) -> dict[str, Any]:
+    return {"rtol": float(conv.rtol), "atol": float(conv.atol), "n": int(conv.n),
+            "t_max": None if conv.t_max is None else float(conv.t_max)}
+
+
+def _check_common(model, numerics, convergence) -> None:
+    model_description(model)  # validates the model type
+    if not isinstance(numerics, micro.Numerics):
+        raise ValueError(f"numerics must be a micro.Numerics, got {type(numerics).__name__}")
+    if not isinstance(convergence, micro.Convergence):
+        raise ValueError(f"convergence must be a micro.Convergence, got {type(convergence).__name__}")
+    numerics.settings(model)  # eps within the solver's range, or a ValueError naming eps
+
+
+class _TaskBase:
+    kind: str = "task"
+
+    def describe(self) -> dict[str, Any]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @property
+    def key(self) -> str:
+        """Cache key: SHA-256 of the canonical description and the code version."""
+        text = json.dumps({"task": self.describe(), "code": code_version()}, sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def label(self) -> str:
+        d = self.describe()
+        m = d["model"]
+        extra = f" V={d['V']:.4g}" if "V" in d else ""
+        return f"{self.kind} k0={m['k0']:g} k1={m['k1']:g} k2={m['k2']:g}{extra}"
+
+
+@dataclass(frozen=True)
+class StationaryTask(_TaskBase):
+    """``micro.stationary(model, V, numerics=..., convergence=...)``."""
+
+    model: micro.Model
+    V: float
+    numerics: micro.Numerics
+    convergence: micro.Convergence
+    kind = "stationary"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "V", positive("V", self.V))
+        _check_common(self.model, self.numerics, self.convergence)
+
+    def describe(self) -> dict[str, Any]:
+        return {"kind": self.kind, "model": model_description(self.model), "V": self.V,
+                "numerics": _numerics_description(self.numerics, self.model),
+                "convergence": _convergence_description(self.convergence)}
+
+    def run(self) -> dict[str, Any]:
+        res = micro.stationary(self.model, self.V, numerics=self.numerics, convergence=self.convergence)
+        return res.to_dict()
+
+
+@dataclass(frozen=True)
+class CriticalTask(_TaskBase):
+    """``micro.critical_velocity(model, V_min=..., V_max=..., rel_tol=..., V_guess=..., factor=...)``
+    (bracketing outward from ``V_guess`` by ``factor``, then bisection)."""
+
+    model: micro.Model
+    V_min: float
+    V_max: float
+    rel_tol: float
+    numerics: micro.Numerics
+    convergence: micro.Convergence
+    V_guess: float = 1.0
+    factor: float = 4.0
+    kind = "critical"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "V_min", positive("V_min", self.V_min))
+        object.__setattr__(self, "V_max", positive("V_max", self.V_max))
+        if not self.V_max > self.V_min:
+            raise ValueError(f"V_max must be > V_min = {self.V_min!r}, got {self.V_max!r}")
+        object.__setattr__(self, "rel_tol", in_range("rel_tol", self.rel_tol, 0.0, 1.0,
+                                                     low_open=True, high_open=True))
+        object.__setattr__(self, "V_guess", in_range("V_guess", self.V_guess, self.V_min, self.V_max))
+        object.__setattr__(self, "factor", in_range("factor", self.factor, 1.0, 1e3, low_open=True))
+        _check_common(self.model, self.numerics, self.convergence)
+
+    def describe(self) -> dict[str, Any]:
+        return {"kind": self.kind, "model": model_description(self.model), "V_min": self.V_min,
+                "V_max": self.V_max, "rel_tol": self.rel_tol,
+                "V_guess": self.V_guess, "factor": self.factor,
+                "numerics": _numerics_description(self.numerics, self.model),
+                "convergence": _convergence_description(self.convergence)}
+
+    def run(self) -> dict[str, Any]:
+        crit = micro.critical_velocity(self.model, V_min=self.V_min, V_max=self.V_max, rel_tol=self.rel_tol,
+                                       V_guess=self.V_guess, factor=self.factor, numerics=self.numerics, convergence=self.convergence)
+        out = crit.to_dict()
+        out["evaluations"] = crit.evaluations
+        return out
+
+
+@dataclass(frozen=True)
+class SlideHoldSlideTask(_TaskBase):
+    """``micro.slide_hold_slide(model, V, hold_times, ...)``."""
+
+    model: micro.Model
+    V: float
+    hold_times: tuple[float, ...]
+    numerics: micro.Numerics
+    convergence: micro.Convergence
+    kind = "slide_hold_slide"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "V", positive("V", self.V))
+        holds = tuple(float(h) for h in self.hold_times)
+        if not holds or any(not (math.isfinite(h) and h >= 0.0) for h in holds):
+            raise ValueError(f"hold_times must be a non-empty sequence of finite numbers >= 0, got {self.hold_times!r}")
+        object.__setattr__(self, "hold_times", holds)
+        _check_common(self.model, self.numerics, self.convergence)
+
+    def describe(self) -> dict[str, Any]:
+        return {"kind": self.kind, "model": model_description(self.model), "V": self.V,
+                "hold_times": list(self.hold_times),
+                "numerics": _numerics_description(self.numerics, self.model),
+                "convergence": _convergence_description(self.convergence)}
+
+    def run(self) -> dict[str, Any]:
+        frame = micro.slide_hold_slide(self.model, self.V, list(self.hold_times), numerics=self.numerics,
+                                       convergence=self.convergence)
+        return {"rows": frame.to_dict("records")}
+
+
+Task = StationaryTask | CriticalTask | SlideHoldSlideTask
+
+#: Exceptions that are a deterministic answer for these inputs (cached like a result).
+DETERMINISTIC_ERRORS = (ValueError,)
+
+
+def execute(task: Task) -> dict[str, Any]:
+    """Run ``task`` and return its record (JSON-serialisable).
+
+    ``status`` is ``"ok"`` with ``result``, or ``"error"`` with ``error`` (the exception
+    type and message); ``cacheable`` says whether the record is a deterministic answer
+    (results and ``ValueError``) that may be stored.
+    """
+    start = time.perf_counter()
+    record: dict[str, Any] = {"key": task.key, "task": task.describe(), "code_version": code_version()}
+    try:
+        record["result"] = task.run()
+        record["status"] = "ok"
+        record["cacheable"] = True
+    except DETERMINISTIC_ERRORS as exc:
+        record.update(status="error", error=f"{type(exc).__name__}: {exc}", cacheable=True)
+    except Exception as exc:  # noqa: BLE001 - reported in the record, never hidden
+        log.exception("task %s failed", task.label())
+        record.update(status="error", error=f"{type(exc).__name__}: {exc}", cacheable=False)
+    record["wall_time"] = time.perf_counter() - start
+    return record
+
+
+def warm_up() -> float:
+    """Compile (or load from numba's disk cache) micro's kernels in this process with a
+    tiny run; returns the seconds it took.  Used as the initializer of pool workers."""
+    start = time.perf_counter()
+    model = micro.Model(k0=0.5)
+    micro.simulate(model, 5.0, duration=0.5, numerics=micro.Numerics(eps=model.kappa * model.zbar / 4.0))
+    return time.perf_counter() - start

@@ -1,0 +1,117 @@
+"""The fits against synthetic data with known answers and against closed forms."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import rsf
+from compare import fits
+from compare.rs_side import classical_rs, rs_slide_hold_slide
+
+
+def _eq10_frame(rng, A, B, offsets, V, noise):
+    rows = []
+    for k0, mu in offsets.items():
+        for v in V:
+            rows.append({"k0": k0, "V": v, "regime": "steady", "converged": True,
+                         "sigma_mean": mu + A / (v + B) + noise * rng.standard_normal()})
+    return pd.DataFrame(rows)
+
+
+def test_fit_steady_law_recovers_known_constants(rng):
+    A, B, offsets = 0.007, 0.078, {1.0: 0.80, 0.3: 0.87, 0.1: 0.89}
+    V = np.geomspace(0.01, 10.0, 12)
+    noise = 2e-5
+    fit = fits.fit_steady_law(_eq10_frame(rng, A, B, offsets, V, noise))
+    assert abs(fit.A - A) < 4 * fit.A_err and fit.A_err < 0.02 * A
+    assert abs(fit.B - B) < 4 * fit.B_err and fit.B_err < 0.05 * B
+    for k0, mu in offsets.items():
+        assert fit.mu_inf(k0) == pytest.approx(mu, abs=5 * noise)
+    assert fit.rms == pytest.approx(noise, rel=0.5)
+
+
+def test_fit_steady_law_exact_data_is_exact(rng):
+    fit = fits.fit_steady_law(_eq10_frame(rng, 0.01, 0.2, {0.5: 0.9}, np.geomspace(0.01, 10, 8), 0.0))
+    assert fit.A == pytest.approx(0.01, rel=1e-6) and fit.B == pytest.approx(0.2, rel=1e-6)
+
+
+def test_fit_steady_law_skips_stick_slip_rows(rng):
+    frame = _eq10_frame(rng, 0.007, 0.078, {1.0: 0.8}, np.geomspace(0.01, 10, 8), 0.0)
+    frame.loc[0, "regime"] = "stick-slip"
+    frame.loc[0, "sigma_mean"] = 5.0          # would ruin the fit if used
+    assert fits.fit_steady_law(frame).B == pytest.approx(0.078, rel=1e-6)
+
+
+def test_fit_dc_recovers_known_dc():
+    law = rsf.HyperbolicLaw(mu_inf=0.9)
+    Dc_true = 0.045
+    pts = pd.DataFrame([(k0, r * rsf.critical_velocity(law, k0, Dc_true).Vc)
+                        for k0 in (0.3, 0.1) for r in (0.1, 0.4, 0.8, 1.5)], columns=["k0", "V"])
+    diagram = fits.rs_diagram(pts, lambda k0: law, Dc_true)
+    assert set(diagram.regime) == {"steady", "stick-slip"}
+    fit = fits.fit_dc(diagram, lambda k0: law, bounds=(0.01, 0.3), n_grid=15, n_bootstrap=30)
+    assert fit.Dc == pytest.approx(Dc_true, rel=2e-3)
+    assert fit.rms < 1e-4
+    assert fit.regime_agreement == 1.0
+    assert fit.Dc_profile[0] <= fit.Dc <= fit.Dc_profile[1]
+    frame = fit.to_frame()
+    assert list(frame.Dc) == [fit.Dc]
+
+
+def test_dc_from_critical_velocity_inverts_the_stability_analysis():
+    law = rsf.HyperbolicLaw(mu_inf=0.0)
+    for k0, Dc in ((0.1, 0.06), (0.01, 0.02), (0.3, 0.05)):
+        Vc = rsf.critical_velocity(law, k0, Dc).Vc
+        assert fits.dc_from_critical_velocity(law.A, law.B, k0, Vc) == pytest.approx(Dc, rel=1e-9)
+
+
+@pytest.mark.parametrize("given", [True, False])
+def test_fit_power_law_recovers_exponent(rng, given):
+    Vc, beta, c = 1.3, 0.5, 0.2
+    V = Vc * (1 - np.geomspace(1e-3, 0.5, 10))
+    amp = c * (Vc - V) ** beta * (1 + 1e-3 * rng.standard_normal(V.size))
+    f = fits.fit_power_law(V, amp, Vc=Vc if given else None)
+    assert f.exponent == pytest.approx(beta, abs=max(4 * f.exponent_err, 1e-3))
+    assert f.Vc == pytest.approx(Vc, rel=1e-3)
+
+
+@pytest.mark.parametrize("law,params", [("exponential", (0.05, 2.0)), ("algebraic", (0.08, 0.7)),
+                                        ("logarithmic", (0.01, 0.03))])
+def test_fit_growth_law_recovers_parameters(rng, law, params):
+    t = np.geomspace(0.05, 50, 12)
+    d = fits.GROWTH_LAWS[law][0](t, *params) * (1 + 1e-3 * rng.standard_normal(t.size))
+    g = fits.fit_growth_law(t, d, law)
+    assert g.success
+    assert g.values[0] == pytest.approx(params[0], rel=1e-2)
+    assert g.values[1] == pytest.approx(params[1], rel=3e-2)
+    others = [fits.fit_growth_law(t, d, o).rel_rms for o in fits.GROWTH_LAWS if o != law]
+    assert g.rel_rms < min(others)
+
+
+def test_rs_eq11_peak_is_bounded_by_the_aging_closed_form():
+    r"""With a = 0 the state ages as d theta/dt = 1 while stuck, so the peak is
+    phi(theta) with theta >= D_c/V + hold: Delta sigma lies between
+    A/(D_c/(D_c/V + hold) + B) - A/(V + B) and its hold -> infinity limit A/B - A/(V + B)."""
+    law = rsf.HyperbolicLaw(mu_inf=0.9)
+    k0, Dc, V = 0.3, 0.06, 3.0
+    holds = np.array([0.1, 1.0, 10.0])
+    out = rs_slide_hold_slide(rsf.SpringSlider(law=law, k0=k0, Dc=Dc), V, holds)
+    lower = law.A / (Dc / (Dc / V + holds) + law.B) - law.A / (V + law.B)
+    upper = law.A / law.B - law.A / (V + law.B)
+    d = out.delta_sigma_max.to_numpy()
+    assert np.all(d >= lower * (1 - 1e-6)) and np.all(d <= upper * (1 + 1e-9))
+    assert np.all(np.diff(d) > 0)
+
+
+def test_classical_rs_is_tangent_to_the_law():
+    law = rsf.HyperbolicLaw(mu_inf=0.9)
+    V = 2.0
+    model = classical_rs(law, V, b=0.01, k0=0.1, Dc=0.06)
+    W = float(law.weakening(np.array([V]))[0])
+    assert model.law.b - model.law.a == pytest.approx(W, rel=1e-12)
+    assert model.sigma_steady(V) == pytest.approx(float(law.mu_ss(np.array([V]))[0]), rel=1e-12)
+    with pytest.raises(ValueError, match="b must be > W"):
+        classical_rs(law, V, b=W / 2, k0=0.1, Dc=0.06)

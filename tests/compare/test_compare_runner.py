@@ -1,0 +1,114 @@
+"""Runner: disk cache (resume after an interruption, instant rerun), pool == serial;
+bad input raises a ValueError that names the parameter."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import compare
+import micro
+from compare import runner as runner_module
+from compare.cache import PointCache
+from compare.runner import Runner
+from compare.tasks import StationaryTask, execute
+
+# cheap micro points: a stiff spring (k0 > k2: always steady), a coarse bin
+MODEL = micro.Model(k0=1.0)
+NUM = micro.Numerics(eps=0.03)
+CONV = micro.Convergence()
+
+
+def _same(records_a, records_b) -> bool:
+    """Equal results (NaN == NaN, as in the JSON the cache stores)."""
+    dump = lambda recs: [json.dumps(r["result"], sort_keys=True) for r in recs]  # noqa: E731
+    return dump(records_a) == dump(records_b)
+
+
+def _tasks(velocities=(1.0, 2.0, 4.0)):
+    return [StationaryTask(MODEL, V, NUM, CONV) for V in velocities]
+
+
+def test_interrupted_sweep_resumes_and_rerun_is_instant(tmp_path, monkeypatch):
+    tasks = _tasks()
+    calls = []
+
+    def interrupted(task):
+        if len(calls) == 1:
+            raise KeyboardInterrupt
+        calls.append(task.V)
+        return execute(task)
+
+    monkeypatch.setattr(runner_module, "execute", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        with Runner(PointCache(tmp_path), workers=1, progress=False) as r:
+            r.run(tasks)
+    assert len(PointCache(tmp_path)) == 1                      # the finished point was kept
+    monkeypatch.setattr(runner_module, "execute", execute)
+
+    with Runner(PointCache(tmp_path), workers=1, progress=False) as r:
+        first = r.run(tasks)
+        assert (r.stats.cached, r.stats.computed) == (1, 2)    # only the missing points
+    with Runner(PointCache(tmp_path), workers=1, progress=False) as r:
+        again = r.run(tasks)
+        assert (r.stats.cached, r.stats.computed) == (3, 0)    # nothing recomputed
+    assert _same(again, first)
+    assert all(rec["status"] == "ok" and rec["result"]["regime"] == "steady" for rec in first)
+
+
+def test_cache_key_changes_with_every_parameter():
+    base = StationaryTask(MODEL, 1.0, NUM, CONV)
+    variants = [StationaryTask(MODEL, 1.0 + 1e-9, NUM, CONV),
+                StationaryTask(micro.Model(k0=1.0, k1=0.2), 1.0, NUM, CONV),
+                StationaryTask(MODEL, 1.0, micro.Numerics(eps=0.031), CONV),
+                StationaryTask(MODEL, 1.0, NUM, micro.Convergence(rtol=2e-2))]
+    keys = {base.key} | {v.key for v in variants}
+    assert len(keys) == 1 + len(variants)
+    assert StationaryTask(micro.Model(k0=1.0), 1.0, micro.Numerics(eps=0.03), micro.Convergence()).key == base.key
+
+
+def test_unreadable_cache_file_is_recomputed(tmp_path):
+    task = _tasks((2.0,))[0]
+    cache = PointCache(tmp_path)
+    cache.path(task.key).parent.mkdir(parents=True)
+    cache.path(task.key).write_text("{not json")
+    with Runner(cache, workers=1, progress=False) as r:
+        rec = r.run([task])[0]
+        assert r.stats.computed == 1
+    assert _same([json.loads(cache.path(task.key).read_text())], [rec])
+
+
+def test_pool_result_equals_serial_result():
+    tasks = _tasks((1.0, 3.0))
+    with Runner(compare.NullCache(), workers=1, progress=False) as r:
+        serial = r.run(tasks)
+    with Runner(compare.NullCache(), workers=2, progress=False) as r:
+        pooled = r.run(tasks)
+    for a, b in zip(serial, pooled):
+        for name in ("regime", "sigma_max", "sigma_min", "sigma_mean", "t_end"):
+            assert a["result"][name] == b["result"][name]
+
+
+@pytest.mark.parametrize("make,name", [
+    (lambda: compare.Settings(k0=(-0.1,)), "k0"),
+    (lambda: compare.Settings(eps=0.0), "eps"),
+    (lambda: compare.Settings(k1=-1.0), "k1"),
+    (lambda: compare.Settings(hopf_distances=(0.1, 2.0, 0.3)), "hopf_distances"),
+    (lambda: compare.Settings(scenarios=("bifurcation", "nope")), "scenarios"),
+    (lambda: compare.Settings(dc_bounds=(0.1, 0.01)), "dc_bounds"),
+    (lambda: compare.Settings(k0=("a",)), "k0"),
+    (lambda: Runner(compare.NullCache(), workers=0), "workers"),
+    (lambda: StationaryTask(MODEL, -1.0, NUM, CONV), "V"),
+    (lambda: compare.report(Dc=-0.06), "Dc"),
+    (lambda: compare.fit_growth_law([1, 2, 3], [1, 2, 3], "linear"), "law"),
+    (lambda: compare.fit_power_law([0.1, 0.2, 0.3], [1, 2, 3], Vc=0.2), "Vc"),
+])
+def test_bad_input_names_the_parameter(make, name):
+    with pytest.raises(ValueError, match=rf"^{name}\b"):
+        make()
+
+
+def test_fit_dc_rejects_bad_bounds():
+    import pandas as pd
+    with pytest.raises(ValueError, match=r"bounds"):
+        compare.fit_dc(pd.DataFrame(columns=["k0", "V", "regime", "sigma_max", "sigma_min"]), None, bounds=(0.1, 0.01))
