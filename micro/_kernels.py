@@ -66,9 +66,8 @@ F_WIN_INT = 18
 F_WIN_LEN = 19
 F_OWED = 20  # shift (bins) owed to the next step
 F_REC_SIGMA = 21  # stress at the last record
-F_LATE = 22  # mass found past the threshold at synchronisations (missed by the scan)
-F_YMEAN = 23  # exact mean delta_R = k2 <u>: it only relaxes, exp(-gamma t) (jumps keep u)
-N_FSTATE = 24
+F_YMEAN = 22  # exact mean delta_R = k2 <u>: it only relaxes, exp(-gamma t) (jumps keep u)
+N_FSTATE = 23
 
 # --- integer state -----------------------------------------------------------------
 I_OFF = 0  # column of d = 0
@@ -742,7 +741,6 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, 
             ist[I_CUR] = b
             ist[I_SYNCS] += 1
             a = b
-            fst[F_LATE] += max(jumped, 0.0)
             fst[F_OWED] += _apply_jumps(fst, prm, max(jumped, 0.0), moment)
             if code != DONE:
                 return code
