@@ -11,7 +11,9 @@ def capped_t_max(model: micro.Model, V: float, eps: float, budget: float) -> flo
     (the first loads the springs from rest, which is cheaper than sliding and made a
     one-run calibration underestimate the cost four-fold at k0 = 1e-3, V = 175).
     """
-    probe = 0.05 * max(model.kappa * model.zbar / (model.k0 * V), 1.0)
+    # a twentieth of a loading time, but at most 2 time units (at small V the cost is
+    # the synchronisations, ~140 per unit time, not the drive)
+    probe = min(0.05 * max(model.kappa * model.zbar / (model.k0 * V), 1.0), 2.0)
     numerics = micro.Numerics(eps=eps)
     first = micro.simulate(model, V, duration=probe, numerics=numerics)
     second = micro.simulate(model, V, duration=probe, numerics=numerics, initial=first.grid)

@@ -14,6 +14,7 @@ The obvious entry points::
 """
 from __future__ import annotations
 
+from .grid import GridTooLarge
 from .analytic import sigma_deterministic_steady, sigma_fast_limit, sigma_slow_limit
 from .params import Deterministic, Exponential, JumpDistribution, Model, Tabulated
 from .protocols import Drive
@@ -43,6 +44,7 @@ __all__ = [
     "Run",
     "Stationary",
     "Critical",
+    "GridTooLarge",
     "simulate",
     "stationary",
     "critical_velocity",

@@ -23,6 +23,11 @@ log = logging.getLogger(__name__)
 TAIL_MASS = 1e-12
 
 
+class GridTooLarge(MemoryError):
+    """The density's support outgrew the memory allowed for the grid
+    (``Numerics.max_memory_gib``)."""
+
+
 @dataclass(frozen=True)
 class GridSettings:
     """Numerical settings of the Fokker-Planck grid.
@@ -36,12 +41,15 @@ class GridSettings:
         synchronisations of the stored delta_R (the relaxation itself is exact; this
         bounds how stale the stored positions get), 0 < theta_relax <= 2.
     dt_max : largest time step (may be infinite).
+    max_bytes : largest memory for the grid's arrays; growing past it raises
+        :class:`GridTooLarge`.
     """
 
     eps: float = 2e-3
     theta_shift: float = 0.5
     theta_relax: float = 0.5
     dt_max: float = 1.0
+    max_bytes: float = 4.0 * 2**30
 
     def __post_init__(self) -> None:
         for name in ("eps", "theta_shift", "theta_relax"):
@@ -141,6 +149,17 @@ class Grid:
 
     # ----------------------------------------------------------------------------- set-up
     def _allocate(self, nrow: int, ncol: int) -> None:
+        needed = 3 * 2 * 8 * nrow * ncol  # three float arrays, two buffers each
+        if needed > self.settings.max_bytes:
+            m = self.model
+            t = float(self.fst[K.F_T]) if hasattr(self, "fst") else 0.0
+            raise GridTooLarge(
+                f"micro: the density needs a {nrow} x {ncol} grid ({needed / 2**30:.1f} GiB) at k0 = {m.k0:g}, "
+                f"eps = {self.settings.eps:g}, t = {t:.4g}, over the limit of "
+                f"{self.settings.max_bytes / 2**30:.1f} GiB (Numerics.max_memory_gib). Its support spreads when "
+                f"global shocks slip far (~ stress drop / k0 = {0.1 / m.k0:.3g} at this k0), as at small k0 and small V; "
+                f"use a coarser eps, a larger max_memory_gib, or the N-block solver (micro.nblock)"
+            )
         self.bufM = np.zeros((2, nrow, ncol))
         self.bufW = np.zeros((2, nrow, ncol))
         self.bufO = np.zeros((2, nrow, ncol))

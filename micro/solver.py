@@ -50,13 +50,18 @@ def default_eps(model: Model) -> float:
 
 @dataclass(frozen=True)
 class Numerics:
-    """Discretisation: bin ``eps`` (default :func:`default_eps`) and the step limits."""
+    """Discretisation: bin ``eps`` (default :func:`default_eps`), the step limits, and the
+    memory the grid may take (``max_memory_gib``; beyond it a run raises
+    :class:`~micro.grid.GridTooLarge` instead of exhausting the machine)."""
 
     eps: float | None = None
     theta_shift: float = 0.5
     theta_relax: float = 0.5
+    max_memory_gib: float = 4.0
 
     def __post_init__(self) -> None:
+        if not (math.isfinite(self.max_memory_gib) and self.max_memory_gib > 0.0):
+            raise ValueError(f"max_memory_gib must be a finite number > 0, got {self.max_memory_gib!r}")
         if self.eps is not None and not (math.isfinite(self.eps) and self.eps > 0.0):
             raise ValueError(f"eps must be a finite number > 0 (or None for the default), got {self.eps!r}")
         if not (0.0 < self.theta_shift <= 1.0):
@@ -66,7 +71,8 @@ class Numerics:
 
     def settings(self, model: Model) -> GridSettings:
         eps = default_eps(model) if self.eps is None else float(self.eps)
-        settings = GridSettings(eps=eps, theta_shift=self.theta_shift, theta_relax=self.theta_relax, dt_max=math.inf)
+        settings = GridSettings(eps=eps, theta_shift=self.theta_shift, theta_relax=self.theta_relax, dt_max=math.inf,
+                                max_bytes=self.max_memory_gib * 2**30)
         settings.check(model)
         return settings
 

@@ -91,3 +91,18 @@ def test_hold_times_must_be_nonnegative():
     model = micro.Model(k0=1.0)
     with pytest.raises(ValueError, match=r"hold times must be finite numbers >= 0"):
         micro.slide_hold_slide(model, 5.0, [1.0, -2.0], numerics=micro.Numerics(eps=0.02))
+
+
+def test_a_grid_outgrowing_its_memory_limit_raises_a_clear_error():
+    # k0 = 1e-4 at small V: a global shock slips ~ 0.1 / k0 = 1000 and the density's
+    # support grows with it (60 GiB here without the limit; it used to be killed by the OS)
+    model = micro.Model(k0=1e-4)
+    numerics = micro.Numerics(eps=model.kappa * model.zbar / 4.0, max_memory_gib=0.05)
+    with pytest.raises(micro.GridTooLarge, match="max_memory_gib"):
+        micro.simulate(model, 1e-4, duration=0.5, numerics=numerics)
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf")])
+def test_memory_limit_is_validated(bad):
+    with pytest.raises(ValueError, match="max_memory_gib"):
+        micro.Numerics(max_memory_gib=bad)
