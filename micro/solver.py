@@ -375,7 +375,10 @@ def stationary(
             tol = convergence.rtol * (abs(float(np.mean(means)) - s_inf) + jitter) + convergence.atol
             agree = all(abs(means[i] - means[k]) <= tol + 2.0 * math.hypot(errors[i], errors[k])
                         for i in range(n) for k in range(i + 1, n))
-            if len(recent) == 0 and np.all(np.isfinite(means)) and agree:
+            # a loading phase (blocks stuck, the stress rising at k0 V) can look flat when
+            # k0 V span is below the tolerance: require the blocks to keep up with the drive
+            loading = abs(means[-1] - means[0]) > 0.25 * model.k0 * V * (n - 1) * span
+            if len(recent) == 0 and np.all(np.isfinite(means)) and agree and not loading:
                 regime, converged = "steady", True
                 message = f"steady: {n} span means agree within {tol:.3g} plus their statistical error"
                 sigma = float(np.mean(means))

@@ -91,3 +91,13 @@ def test_fast_steady_sliding_has_no_shocks():
     settled = run.records[run.records.t > 1.0]
     assert settled.sigma.max() - settled.sigma.min() < 20 * model.k0 * 0.016
     assert settled.sigma.mean() == pytest.approx(micro.sigma_fast_limit(model, 57.6), abs=1e-4)
+
+
+def test_a_slow_loading_phase_is_not_taken_for_steady_sliding():
+    # k0 = 1e-4, V = 1 is deep in the stick-slip regime: the stress loads at k0 V = 1e-4
+    # per unit time for ~700 time units before the first shock.  Span means then differ
+    # by less than the steady tolerance; the run used to stop there as "steady"
+    # (sigma = 0.952 at t = 529).
+    model = micro.Model(k0=1e-4)
+    res = micro.stationary(model, 1.0, numerics=micro.Numerics(eps=0.025), convergence=micro.Convergence(t_max=600.0))
+    assert not (res.converged and res.regime == "steady")
