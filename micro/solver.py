@@ -386,7 +386,8 @@ def stationary(
                            sigma_stderr=float(math.sqrt(np.sum(np.square(errors))) / n))
                 break
         if elapsed >= t_max or code != K.DONE:
-            regime, message, out = _unconverged(rec, cycles, hysteresis, t_now, span, elapsed, t_max, code)
+            regime, message, out = _unconverged(rec, cycles, hysteresis, t_now, span, elapsed, t_max, code,
+                                                load_rate=model.k0 * V)
             break
         # lengthen the chunks while no cycle has shown up (slow stick-slip)
         if len(cycles) == 0:
@@ -440,13 +441,25 @@ def _span_means(rec: Records, start: float, span: float, n: int, parts: int = 8)
 
 
 def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: float, span: float,
-                 elapsed: float, t_max: float, code: int) -> tuple[str, str, dict]:
+                 elapsed: float, t_max: float, code: int, load_rate: float) -> tuple[str, str, dict]:
     """Regime and best estimates of a run that did not meet its stopping test."""
     why = f"not converged by t_max = {t_max:.4g}" if code == K.DONE else f"stopped early (kernel code {code})"
     if len(cycles) >= 3:
         amp = (cycles.sigma_max - cycles.sigma_min).to_numpy()
         last = cycles.iloc[-3:]
         ratio = float(amp[-1] / amp[-3]) ** 0.5 if amp[-3] > 0 else math.nan
+        # a stick-slip transient also decays, but towards a finite cycle: extrapolate the
+        # amplitudes geometrically (Aitken) when they fall monotonically and are well
+        # above the grid's resolution (near V^c the amplitudes are noise-dominated)
+        d1, d2 = amp[-2] - amp[-3], amp[-1] - amp[-2]
+        limit = math.nan
+        if d1 < 0.0 and d2 < 0.0 and d2 / d1 < 1.0 and amp[-1] > 20.0 * hysteresis:
+            limit = float(amp[-1] - d2 * (d2 / d1) / (1.0 - d2 / d1))
+        if ratio < 0.999 and limit > 0.5 * amp[-1]:
+            detail = f"; the oscillation decays towards a cycle of amplitude {limit:.3g} (stick-slip attractor)"
+            return "stick-slip", why + detail, dict(
+                sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
+                sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
         if ratio < 0.999:
             regime = "steady"
             detail = f"; the oscillation decays by {ratio:.4f} per cycle (steady attractor)"
@@ -459,6 +472,10 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
     sigma = rec.time_mean(t_now - span, t_now)
     lo = rec.since(t_now - span)
     amplitude = float(lo.sigma_max.max() - lo.sigma_min.min()) if len(lo) else math.nan
+    rise = float(lo.sigma[-1] - lo.sigma[0]) if len(lo) else math.nan
+    if rise > 0.25 * load_rate * span:  # blocks lag the drive: still loading towards a slip
+        return "unknown", why + f"; still loading (the stress rose {rise:.3g} over the last span)", dict(
+            sigma_max=float(lo.sigma_max.max()), sigma_min=float(lo.sigma_min.min()), sigma_mean=sigma, period=math.nan)
     regime = "steady" if amplitude <= 4.0 * hysteresis else "unknown"
     return regime, why + f"; last span amplitude {amplitude:.3g}", dict(
         sigma_max=sigma if regime == "steady" else float(lo.sigma_max.max()),
