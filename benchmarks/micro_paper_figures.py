@@ -46,6 +46,15 @@ VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51, 0.001: 116.5, 0.0001: 1167.0}
 RATIOS = (0.03, 0.1, 0.3, 0.6, 0.85, 1.2, 2.0, 5.0)
 
 
+def _finish(fig, ax, xlabel: str, ylabel: str, title: str, name: str) -> None:
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(FIGS / f"{name}.png", dpi=120)
+
+
 def fig3(eps: float, budget: float) -> None:
     model = micro.Model(k0=0.01)
     frames = []
@@ -63,12 +72,7 @@ def fig3(eps: float, budget: float) -> None:
     fig, ax = plt.subplots(figsize=(6, 3.6))
     for V, d in data.groupby("V"):
         ax.plot(d.t * V, d.sigma, lw=0.8, label=f"V = {V:g}")
-    ax.set_xlabel("drive displacement w = V t")
-    ax.set_ylabel("stress sigma")
-    ax.set_title("Fig. 3 (micro, k0 = 0.01)")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(FIGS / "micro_fig3.png", dpi=120)
+    _finish(fig, ax, "drive displacement w = V t", "stress sigma", "Fig. 3 (micro, k0 = 0.01)", "micro_fig3")
 
 
 def fig4(eps: float, budget: float, k0s) -> pd.DataFrame:
@@ -99,12 +103,8 @@ def fig4(eps: float, budget: float, k0s) -> pd.DataFrame:
         bad = d[~d.converged.astype(bool)]
         ax.semilogx(bad.V, bad.sigma_max, "o", mfc="white", color=line.get_color(), ms=7)
         ax.semilogx(bad.V, bad.sigma_min, "s", mfc="white", color=line.get_color(), ms=7)
-    ax.set_xlabel("driving velocity V")
-    ax.set_ylabel("sigma_max (o), sigma_min (s)")
-    ax.set_title("Fig. 4 (micro; open symbols: not converged within the budget)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(FIGS / "micro_fig4.png", dpi=120)
+    _finish(fig, ax, "driving velocity V", "sigma_max (o), sigma_min (s)",
+            "Fig. 4 (micro; open symbols: not converged within the budget)", "micro_fig4")
     return data
 
 
@@ -119,12 +119,7 @@ def fig6(data: pd.DataFrame) -> None:
     ref = micro.Model(k0=0.1)
     law = [micro.sigma_fast_limit(ref, v) - micro.sigma_fast_limit(ref) for v in V_line]
     ax.loglog(V_line, law, "k--", lw=0.8, label="k2 gamma Var(R) / V (large-V law)")
-    ax.set_xlabel("driving velocity V")
-    ax.set_ylabel("sigma(V) - sigma(V = inf)")
-    ax.set_title("Fig. 6 (micro, steady branch)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(FIGS / "micro_fig6.png", dpi=120)
+    _finish(fig, ax, "driving velocity V", "sigma(V) - sigma(V = inf)", "Fig. 6 (micro, steady branch)", "micro_fig6")
 
 
 def fig7(eps: float) -> None:
@@ -149,12 +144,7 @@ def fig7(eps: float) -> None:
     grid = np.linspace(0.0, holds.max(), 200)
     ax.plot(grid, law(grid, d_inf, tau), "k--", lw=0.8,
             label=f"d_inf (1 - exp(-dt / tau)), tau = {tau:.3f}")
-    ax.set_xlabel("hold time dt")
-    ax.set_ylabel("(delta sigma)_max")
-    ax.set_title("Fig. 7 right (micro)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(FIGS / "micro_fig7.png", dpi=120)
+    _finish(fig, ax, "hold time dt", "(delta sigma)_max", "Fig. 7 right (micro)", "micro_fig7")
 
 
 def main() -> None:
