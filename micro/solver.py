@@ -458,20 +458,17 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
         limit = math.nan
         if d1 < 0.0 and d2 < 0.0 and d2 / d1 < 1.0 and amp[-1] > 20.0 * hysteresis:
             limit = float(amp[-1] - d2 * (d2 / d1) / (1.0 - d2 / d1))
-        if ratio < 0.999 and limit > 0.5 * amp[-1]:
-            detail = f"; the oscillation decays towards a cycle of amplitude {limit:.3g} (stick-slip attractor)"
-            return "stick-slip", why + detail, dict(
-                sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
-                sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
-        if ratio < 0.999:
-            regime = "steady"
+        towards_cycle = limit > 0.5 * amp[-1]
+        if ratio < 0.999 and not towards_cycle:
             detail = f"; the oscillation decays by {ratio:.4f} per cycle (steady attractor)"
             sigma = rec.time_mean(float(last.t_start.iloc[0]), float(last.t_end.iloc[-1]))
-            return regime, why + detail, dict(sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma, period=math.nan)
-        regime = "stick-slip"
-        detail = f"; the oscillation persists (amplitude ratio {ratio:.4f} per cycle)"
-        return regime, why + detail, dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
-                                          sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
+            return "steady", why + detail, dict(sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma, period=math.nan)
+        if ratio < 0.999:
+            detail = f"; the oscillation decays towards a cycle of amplitude {limit:.3g} (stick-slip attractor)"
+        else:
+            detail = f"; the oscillation persists (amplitude ratio {ratio:.4f} per cycle)"
+        return "stick-slip", why + detail, dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
+                                                sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
     sigma = rec.time_mean(t_now - span, t_now)
     lo = rec.since(t_now - span)
     amplitude = float(lo.sigma_max.max() - lo.sigma_min.min()) if len(lo) else math.nan
