@@ -20,6 +20,13 @@ __all__ = ["draw"]
 _COLORS = {0.3: "C0", 0.1: "C1", 0.01: "C2", 0.001: "C3", 0.0001: "C4"}
 
 
+def _save(fig, path: Path) -> Path:
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def _color(k0: float, i: int) -> str:
     for k, c in _COLORS.items():
         if math.isclose(k, k0, rel_tol=1e-9):
@@ -52,10 +59,7 @@ def bifurcation(t: dict[str, pd.DataFrame], Dc: float, path: Path) -> Path:
         ax.set_xlabel("driving velocity V")
         ax.legend(fontsize=7)
     axes[0].set_ylabel("sigma_max, sigma_min")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def dc_profile(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
@@ -68,10 +72,7 @@ def dc_profile(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -
     ax.set_xlabel("D_c")
     ax.set_ylabel("rms(sigma_RS - sigma_micro)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def hopf(t: dict[str, pd.DataFrame], path: Path) -> Path:
@@ -97,10 +98,7 @@ def hopf(t: dict[str, pd.DataFrame], path: Path) -> Path:
     ax.set_ylabel("sigma_max - sigma_min")
     ax.set_title(f"Hopf scaling at k0 = {pts.k0.iloc[0]:g}")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def phase(t: dict[str, pd.DataFrame], Dc: float, path: Path) -> Path:
@@ -123,10 +121,7 @@ def phase(t: dict[str, pd.DataFrame], Dc: float, path: Path) -> Path:
     axes[0][0].set_ylim(1e-3, 1e4)
     axes[0][0].legend(fontsize=6)
     fig.suptitle(f"Phase diagram (Fig. 5), D_c = {Dc:.3g}", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def shs(t: dict[str, pd.DataFrame], path: Path) -> Path:
@@ -151,10 +146,7 @@ def shs(t: dict[str, pd.DataFrame], path: Path) -> Path:
         ax.legend(fontsize=6)
     axes[0][0].set_ylabel("peak - steady stress")
     fig.suptitle("Slide-hold-slide (Fig. 7): growth laws (solid: the model's expected law)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def draw(study, out: Path) -> dict[str, Path]:
