@@ -21,6 +21,8 @@ Writes benchmarks/results/micro_eps_convergence.csv and docs/figures/micro_eps_c
 
     python benchmarks/micro_eps_convergence.py            # about 15 minutes on one core
     python benchmarks/micro_eps_convergence.py --budget 60  # shorter cap per run (seconds)
+    python benchmarks/micro_eps_convergence.py --k0 0.001 --eps 0.008,0.004 --t-max 40
+        # some points only, capped in simulated time; replaces those rows of the CSV
 """
 from __future__ import annotations
 
@@ -49,9 +51,10 @@ VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51, 0.001: 116.5, 0.0001: 1167.0}
 EPS = (0.024, 0.016, 0.012, 0.008, 0.006, 0.004)
 
 
-def run_point(k0: float, V: float, eps: float, budget: float) -> dict:
+def run_point(k0: float, V: float, eps: float, budget: float, t_max: float | None = None) -> dict:
     model = micro.Model(k0=k0)
-    t_max = capped_t_max(model, V, eps, budget)
+    if t_max is None:
+        t_max = capped_t_max(model, V, eps, budget)
     t = time.perf_counter()
     r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(t_max=t_max))
     return dict(k0=k0, V=V, eps=eps, regime=r.regime, converged=r.converged, sigma=r.sigma_mean,
@@ -83,25 +86,34 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--budget", type=float, default=60.0, help="wall-time cap per run, seconds (default 60)")
     ap.add_argument("--k0", type=str, default=",".join(map(str, K0)), help="comma-separated k0 values")
+    ap.add_argument("--t-max", type=float, default=None,
+                    help="cap each run at this simulated time instead of a wall-time budget")
+    ap.add_argument("--eps", type=str, default=",".join(map(str, EPS)), help="comma-separated bins, coarse to fine")
     ap.add_argument("--replot", action="store_true", help="redo the table and plot from the CSV of a previous run")
     args = ap.parse_args()
     out = HERE / "results" / "micro_eps_convergence.csv"
+    columns = ["k0", "V", "eps", "regime", "converged", "sigma", "sigma_stderr", "t_end", "t_max", "wall_s",
+               "mass_error", "min_mass", "message"]
     if args.replot:
-        table = pd.read_csv(out)[["k0", "V", "eps", "regime", "converged", "sigma", "sigma_stderr", "t_end", "t_max",
-                                  "wall_s", "mass_error", "min_mass", "message"]]
+        table = pd.read_csv(out)[columns]
     else:
         k0s = [float(x) for x in args.k0.split(",")]
+        bins = [float(x) for x in args.eps.split(",")]
         micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024))  # compile
         rows = []
         for k0 in k0s:
             V = 1.5 * VC_RS[k0]
-            for eps in EPS:
-                row = run_point(k0, V, eps, args.budget)
+            for eps in bins:
+                row = run_point(k0, V, eps, args.budget, args.t_max)
                 rows.append(row)
                 print({k: row[k] for k in ("k0", "V", "eps", "regime", "converged", "sigma", "wall_s")}, flush=True)
-                if row["wall_s"] > args.budget:
+                if args.t_max is None and row["wall_s"] > args.budget:
                     break  # the next (finer) bin would not fit either
         table = pd.DataFrame(rows)
+        if out.exists():  # keep the other k0 (and bins) of a previous run
+            old = pd.read_csv(out)[columns]
+            keep = ~(old.k0.isin(k0s) & old.eps.isin(bins))
+            table = pd.concat([old[keep], table]).sort_values(["k0", "eps"], ascending=[False, False], ignore_index=True)
     table["reference"] = [micro.sigma_fast_limit(micro.Model(k0=k0), V) if k0 <= 0.01 else math.nan
                           for k0, V in zip(table.k0, table.V)]
     table["weakening"] = [micro.sigma_fast_limit(micro.Model(k0=k0), V) - micro.sigma_fast_limit(micro.Model(k0=k0))
