@@ -113,3 +113,16 @@ def test_an_unconverged_stick_slip_transient_is_labelled_stick_slip():
     assert not res.converged
     assert res.regime == "stick-slip"
     assert "towards a cycle" in res.message or "persists" in res.message
+
+
+def test_a_cycle_of_grid_size_is_flagged():
+    # k0 = 0.01, V = 1000 slides steadily (V^c ~ 10), but at the coarsest bin the grid
+    # keeps a converged oscillation of stress drop 5.4 k0 eps (amplitude ~ eps^2,
+    # docs/micro_results.md): the result must say it may be the grid's.
+    res = micro.stationary(micro.Model(k0=0.01), 1000.0, numerics=micro.Numerics(eps=0.025))
+    assert res.regime == "stick-slip" and res.converged
+    assert "oscillation of the grid" in res.message
+    # a real cycle (k0 = 0.1, V = 0.05: stress drop ~ 40 k0 eps) is not flagged
+    real = micro.stationary(micro.Model(k0=0.1), 0.05, numerics=micro.Numerics(eps=0.016))
+    assert real.regime == "stick-slip" and real.converged
+    assert "grid" not in real.message
