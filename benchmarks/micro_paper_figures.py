@@ -17,6 +17,13 @@ Writes docs/data/micro_fig{3,4,7}.csv and docs/figures/micro_fig{3,4,6,7}.png.
 
     python benchmarks/micro_paper_figures.py               # budget 30 s per point
     python benchmarks/micro_paper_figures.py --figs 4,6 --budget 10
+    python benchmarks/micro_paper_figures.py --figs 4,6 --k0 0.001 --ratios 0.85,1.2,2,5 --eps 0.004 --t-max 12
+        # some points at another bin, capped in simulated time; they replace the same
+        # (k0, V) rows of docs/data/micro_fig4.csv
+    python benchmarks/micro_paper_figures.py --figs 4,6 --replot
+
+A converged cycle flagged as possibly the grid's oscillation (stress drop below
+10 k0 eps, see docs/micro_numerics.md) is drawn as a cross at its mean stress.
 """
 from __future__ import annotations
 
@@ -75,17 +82,23 @@ def fig3(eps: float, budget: float) -> None:
     _finish(fig, ax, "drive displacement w = V t", "stress sigma", "Fig. 3 (micro, k0 = 0.01)", "micro_fig3")
 
 
-def fig4(eps: float, budget: float, k0s) -> pd.DataFrame:
+def _grid_cycle(d: pd.DataFrame) -> pd.Series:
+    return d.message.fillna("").str.contains("oscillation of the grid")
+
+
+def fig4(eps: float, budget: float, k0s, ratios=RATIOS, t_max: float | None = None, replot: bool = False) -> pd.DataFrame:
+    out = DATA / "micro_fig4.csv"
+    old = pd.read_csv(out) if out.exists() else pd.DataFrame(columns=["k0", "V"])
     rows = []
-    for k0 in k0s:
+    for k0 in ([] if replot else k0s):
         model = micro.Model(k0=k0)
-        for r in RATIOS:
+        for r in ratios:
             V = r * VC_RS[k0]
             t = time.perf_counter()
             try:
-                t_max = capped_t_max(model, V, eps, budget)
+                cap = t_max if t_max is not None else capped_t_max(model, V, eps, budget)
                 res = micro.stationary(model, V, numerics=micro.Numerics(eps=eps),
-                                       convergence=micro.Convergence(t_max=t_max))
+                                       convergence=micro.Convergence(t_max=cap))
                 row = res.to_dict()
             except micro.GridTooLarge as exc:  # the solver's clear refusal: kept, drawn nowhere
                 row = dict(k0=k0, V=V, regime="refused", converged=False, sigma_max=math.nan,
@@ -94,22 +107,29 @@ def fig4(eps: float, budget: float, k0s) -> pd.DataFrame:
             rows.append(row)
             print(f"fig 4: k0 = {k0:g}, V = {V:.4g}: {row['regime']} converged={row['converged']} "
                   f"{row['sigma_max']:.5f}/{row['sigma_min']:.5f} in {row['wall_time']:.1f} s", flush=True)
-            pd.DataFrame(rows).to_csv(DATA / "micro_fig4.csv", index=False)  # keep what is done
-    data = pd.DataFrame(rows)
+            new = pd.DataFrame(rows)
+            # keep what is done, replacing the same points of a previous run
+            same = old.k0.isin(new.k0) & np.isclose(old.V.to_numpy(float)[:, None], new.V.to_numpy(float)).any(axis=1)
+            data = pd.concat([old[~same], new]).sort_values(["k0", "V"], ascending=[False, True], ignore_index=True)
+            data.to_csv(out, index=False)
+    data = pd.read_csv(out)
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for k0, d in data.groupby("k0", sort=False):
-        line, = ax.semilogx(d.V, d.sigma_max, "o-", ms=4, label=f"k0 = {k0:g}")
-        ax.semilogx(d.V, d.sigma_min, "s--", ms=4, color=line.get_color())
+        grid = _grid_cycle(d)
+        line, = ax.semilogx(d.V, d.sigma_max.where(~grid, d.sigma_mean), "o-", ms=4, label=f"k0 = {k0:g}")
+        ax.semilogx(d.V, d.sigma_min.where(~grid, d.sigma_mean), "s--", ms=4, color=line.get_color())
+        ax.semilogx(d.V[grid], d.sigma_mean[grid], "x", color=line.get_color(), ms=9)
         bad = d[~d.converged.astype(bool)]
         ax.semilogx(bad.V, bad.sigma_max, "o", mfc="white", color=line.get_color(), ms=7)
         ax.semilogx(bad.V, bad.sigma_min, "s", mfc="white", color=line.get_color(), ms=7)
     _finish(fig, ax, "driving velocity V", "sigma_max (o), sigma_min (s)",
-            "Fig. 4 (micro; open symbols: not converged within the budget)", "micro_fig4")
+            "Fig. 4 (micro; open: not converged; x: grid-size cycle, its mean)", "micro_fig4")
     return data
 
 
 def fig6(data: pd.DataFrame) -> None:
-    steady = data[(data.regime == "steady") & data.converged.astype(bool)]
+    # converged steady points, and converged cycles of grid size (at their mean stress)
+    steady = data[((data.regime == "steady") | _grid_cycle(data)) & data.converged.astype(bool)]
     fig, ax = plt.subplots(figsize=(6, 4))
     V_line = np.logspace(-1, 3.5, 50)
     for k0, d in steady.groupby("k0", sort=False):
@@ -153,6 +173,10 @@ def main() -> None:
     ap.add_argument("--k0", default=",".join(map(str, K0)), help="k0 values of Figs. 4 and 6")
     ap.add_argument("--eps", type=float, default=0.016, help="bin (default 0.016: stress error ~5e-5)")
     ap.add_argument("--budget", type=float, default=30.0, help="wall-time cap per stationary point, s")
+    ap.add_argument("--t-max", type=float, default=None,
+                    help="Fig. 4: cap each point at this simulated time instead of the budget")
+    ap.add_argument("--ratios", default=",".join(map(str, RATIOS)), help="Fig. 4: V / V^c_RS values")
+    ap.add_argument("--replot", action="store_true", help="Figs. 4, 6: redraw from docs/data/micro_fig4.csv")
     args = ap.parse_args()
     figs = {int(f) for f in args.figs.split(",")}
     DATA.mkdir(parents=True, exist_ok=True)
@@ -161,7 +185,8 @@ def main() -> None:
     if 3 in figs:
         fig3(args.eps, 10 * args.budget)
     if 4 in figs or 6 in figs:
-        data = fig4(args.eps, args.budget, [float(k) for k in args.k0.split(",")])
+        data = fig4(args.eps, args.budget, [float(k) for k in args.k0.split(",")],
+                    [float(r) for r in args.ratios.split(",")], args.t_max, args.replot)
         if 6 in figs:
             fig6(data)
     if 7 in figs:
