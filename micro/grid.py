@@ -156,9 +156,9 @@ class Grid:
             raise GridTooLarge(
                 f"micro: the density needs a {nrow} x {ncol} grid ({needed / 2**30:.1f} GiB) at k0 = {m.k0:g}, "
                 f"eps = {self.settings.eps:g}, t = {t:.4g}, over the limit of "
-                f"{self.settings.max_bytes / 2**30:.1f} GiB (Numerics.max_memory_gib). Its support spreads when "
-                f"global shocks slip far (~ stress drop / k0 = {0.1 / m.k0:.3g} at this k0), as at small k0 and small V; "
-                f"use a coarser eps, a larger max_memory_gib, or the N-block solver (micro.nblock)"
+                f"{self.settings.max_bytes / 2**30:.1f} GiB (Numerics.max_memory_gib); the grid has "
+                f"{int(math.ceil(1.0 / self.settings.eps))} bins per unit of delta; use a coarser eps, a larger "
+                f"max_memory_gib, or the N-block solver (micro.nblock)"
             )
         self.bufM = np.zeros((2, nrow, ncol))
         self.bufW = np.zeros((2, nrow, ncol))
@@ -275,6 +275,31 @@ class Grid:
         return {"mass": M[r, c], "delta_F": x, "delta_R": y, "delta": x + y}
 
     # ----------------------------------------------------------------------------- growth
+    def _tighten_extents(self) -> None:
+        """Reset the occupied rows and each row's occupied columns to where mass is.
+
+        The kernels only widen these extents between synchronisations (mass that jumps
+        leaves its cell, and the cell's column stays inside them); during a long
+        cascade, e.g. a global shock at small k0 that slips ~0.1 / k0, the stale low
+        columns made the grid grow without bound (k0 = 1e-4, V = 700 asked for 4.5 GiB
+        while the mass spanned 38 rows and ~200 columns).
+        """
+        cur = int(self.ist[K.I_CUR])
+        M = self.bufM[cur]
+        chi, clo = self.bufchi[cur], self.bufclo[cur]
+        rlo, rhi = int(self.ist[K.I_RLO]), int(self.ist[K.I_RHI])
+        ncol = M.shape[1]
+        occupied = M[rlo:rhi] != 0.0
+        any_mass = occupied.any(axis=1)
+        first = np.where(any_mass, occupied.argmax(axis=1), ncol)
+        last = np.where(any_mass, ncol - occupied[:, ::-1].argmax(axis=1), 0)
+        clo[rlo:rhi] = first
+        chi[rlo:rhi] = last
+        rows = np.flatnonzero(any_mass)
+        if rows.size:
+            self.ist[K.I_RLO] = rlo + int(rows[0])
+            self.ist[K.I_RHI] = rlo + int(rows[-1]) + 1
+
     def _grow_rows(self) -> None:
         cur = int(self.ist[K.I_CUR])
         M = self.bufM[cur]
@@ -392,6 +417,8 @@ class Grid:
             if n_shk:
                 shocks.append(shk[:n_shk].copy())
             seen_shocks += n_shk
+            if code in (K.NEED_ROWS, K.NEED_COLS):
+                self._tighten_extents()
             if code == K.NEED_ROWS:
                 self._grow_rows()
             elif code == K.NEED_COLS:
