@@ -135,6 +135,11 @@ OWED_REL = 0.1
 OWED_FLOOR = 1e-12
 #: Largest shift (bins) of one closure iteration: the scan covers SCAN bins of margin.
 MAX_SHIFT = 2.0
+#: Shortest step.  In a global shock the slip rate estimate of the step rule grows by the
+#: shift of each step over theta_shift; a shock cut into hundreds of steps (each return
+#: to grow or recentre the grid is a new step) overflowed it to inf, and dt to 0
+#: (k0 = 1e-4, V = 35: a ZeroDivisionError).  No time scale of the model is this short.
+DT_MIN = 1e-12
 
 
 @njit(cache=True, inline="always")
@@ -724,7 +729,7 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, 
         # target's k2 * (hbar - hbar_a) term, is kept within one bin: at large V it grows
         # like k2 V gamma t^2 / 2 and would otherwise carry cells past the scan window)
         uniform = fst[F_DRIFT] - (1.0 - fst[F_LAM]) * prm[P_K2] * (fst[F_HBAR] - fst[F_HREF])
-        if gamma > 0.0 and (fst[F_LAM] <= fst[F_LAM_SYNC] or abs(uniform) > eps):
+        if gamma > 0.0 and (fst[F_LAM] <= fst[F_LAM_SYNC] * (1.0 + 1e-12) or abs(uniform) > eps):
             rmin, rmax, cmax = bounds(ist, fst, prm, bufclo[a], bufchi[a])
             if rmin < 1 or rmax > nrow - 2:
                 return NEED_ROWS
@@ -753,7 +758,7 @@ def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, 
         shift_rate = (k0 * velocity + (prm[P_K1] + prm[P_K2]) * fst[F_SLIP_RATE]) / eps
         dt = prm[P_DT_MAX]
         if shift_rate > 0.0:
-            dt = min(dt, prm[P_THETA_S] / shift_rate)
+            dt = min(dt, max(prm[P_THETA_S] / shift_rate, DT_MIN))
         if gamma > 0.0 and fst[F_LAM] > fst[F_LAM_SYNC]:
             dt = min(dt, math.log(fst[F_LAM] / fst[F_LAM_SYNC]) / gamma * (1.0 + 1e-9))
         dt = min(dt, t_stop - t)
