@@ -88,7 +88,6 @@ def _grid_cycle(d: pd.DataFrame) -> pd.Series:
 
 def fig4(eps: float, budget: float, k0s, ratios=RATIOS, t_max: float | None = None, replot: bool = False) -> pd.DataFrame:
     out = DATA / "micro_fig4.csv"
-    old = pd.read_csv(out) if out.exists() else pd.DataFrame(columns=["k0", "V"])
     rows = []
     for k0 in ([] if replot else k0s):
         model = micro.Model(k0=k0)
@@ -108,7 +107,9 @@ def fig4(eps: float, budget: float, k0s, ratios=RATIOS, t_max: float | None = No
             print(f"fig 4: k0 = {k0:g}, V = {V:.4g}: {row['regime']} converged={row['converged']} "
                   f"{row['sigma_max']:.5f}/{row['sigma_min']:.5f} in {row['wall_time']:.1f} s", flush=True)
             new = pd.DataFrame(rows)
-            # keep what is done, replacing the same points of a previous run
+            # keep what is done, replacing the same points of a previous run (read now:
+            # another run may have added points meanwhile)
+            old = pd.read_csv(out) if out.exists() else pd.DataFrame(columns=["k0", "V"])
             same = old.k0.isin(new.k0) & np.isclose(old.V.to_numpy(float)[:, None], new.V.to_numpy(float)).any(axis=1)
             data = pd.concat([old[~same], new]).sort_values(["k0", "V"], ascending=[False, True], ignore_index=True)
             data.to_csv(out, index=False)
