@@ -1,0 +1,54 @@
+"""The critical velocity V^c of the Fokker-Planck solver against the bin eps.
+
+V^c comes from `micro.critical_velocity`, the paper's bisection on the regime (1 %).
+Near V^c the finite-eps dynamics is a noisy oscillation a few grid resolutions (k0 eps)
+wide, so the regime labels there, and the bisection, depend on eps; this script measures
+by how much, and whether V^c settles as eps shrinks.  Each bisection starts from the same
+guess (the RS V^c of Eq. (12) with the paper's A, B, D_c).
+
+Writes benchmarks/results/micro_vc_convergence.csv.
+
+    python benchmarks/micro_vc_convergence.py                      # k0 = 0.1, three bins
+    python benchmarks/micro_vc_convergence.py --k0 0.3 --eps 0.016,0.008
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import pandas as pd
+
+import micro
+
+HERE = Path(__file__).resolve().parent
+VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--k0", type=str, default="0.1", help="comma-separated k0 values (0.3, 0.1, 0.01)")
+    ap.add_argument("--eps", type=str, default="0.016,0.012,0.008", help="comma-separated bins")
+    args = ap.parse_args()
+    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024))  # compile
+    out = HERE / "results" / "micro_vc_convergence.csv"
+    rows = []
+    for k0 in (float(k) for k in args.k0.split(",")):
+        model = micro.Model(k0=k0)
+        for eps in (float(e) for e in args.eps.split(",")):
+            t = time.perf_counter()
+            crit = micro.critical_velocity(model, V_guess=VC_RS[k0], factor=1.5, numerics=micro.Numerics(eps=eps))
+            evals = pd.DataFrame(crit.evaluations)
+            unconverged = int((~evals.converged.astype(bool)).sum())
+            rows.append(dict(crit.to_dict(), eps=eps, evaluations=len(evals), unconverged=unconverged,
+                             wall_s=time.perf_counter() - t))
+            print(f"k0 = {k0:g}, eps = {eps:g}: Vc = {crit.Vc:.4f} [{crit.V_low:.4f}, {crit.V_high:.4f}] "
+                  f"({crit.status}; {len(evals)} runs, {unconverged} unconverged; {rows[-1]['wall_s']:.0f} s)", flush=True)
+            old = pd.read_csv(out) if out.exists() else pd.DataFrame(columns=["k0", "eps"])
+            same = (old.k0 == k0) & (old.eps == eps)
+            pd.concat([old[~same], pd.DataFrame(rows[-1:])], ignore_index=True).to_csv(out, index=False)
+    print(pd.read_csv(out).to_string(index=False))
+
+
+if __name__ == "__main__":
+    main()
