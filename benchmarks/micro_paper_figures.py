@@ -110,7 +110,8 @@ def fig4(eps: float, budget: float, k0s, ratios=RATIOS, t_max: float | None = No
             # keep what is done, replacing the same points of a previous run (read now:
             # another run may have added points meanwhile)
             old = pd.read_csv(out) if out.exists() else pd.DataFrame(columns=["k0", "V"])
-            same = old.k0.isin(new.k0) & np.isclose(old.V.to_numpy(float)[:, None], new.V.to_numpy(float)).any(axis=1)
+            same = (np.isclose(old.k0.to_numpy(float)[:, None], new.k0.to_numpy(float))
+                    & np.isclose(old.V.to_numpy(float)[:, None], new.V.to_numpy(float))).any(axis=1)
             data = pd.concat([old[~same], new]).sort_values(["k0", "V"], ascending=[False, True], ignore_index=True)
             data.to_csv(out, index=False)
     data = pd.read_csv(out)
