@@ -41,14 +41,9 @@ import pandas as pd
 from scipy.optimize import curve_fit
 
 import micro
-from _budget import capped_t_max
+from _budget import K0, VC_RS, capped_t_max, merged
 
 HERE = Path(__file__).resolve().parent
-K0 = (0.3, 0.1, 0.01, 0.001, 0.0001)
-#: RS critical velocity of Eq. (12) with the paper's A = 0.007, B = 0.078, D_c = 0.06
-#: (compare/ reports 0.2029, 1.005, 11.51, 116.5, 1167); micro's is 0.24 and 1.11 at
-#: k0 = 0.3 and 0.1 (docs/compare.md).
-VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51, 0.001: 116.5, 0.0001: 1167.0}
 EPS = (0.024, 0.016, 0.012, 0.008, 0.006, 0.004)
 
 
@@ -111,11 +106,10 @@ def main() -> None:
                 print({k: row[k] for k in ("k0", "V", "eps", "regime", "converged", "sigma", "wall_s")}, flush=True)
                 if args.t_max is None and row["wall_s"] > args.budget:
                     break  # the next (finer) bin would not fit either
-        table = pd.DataFrame(rows)
-        if out.exists():  # keep the other k0 (and bins) of a previous run
-            old = pd.read_csv(out)[columns]
-            keep = ~(old.k0.isin(k0s) & old.eps.isin(bins))
-            table = pd.concat([old[keep], table]).sort_values(["k0", "eps"], ascending=[False, False], ignore_index=True)
+        # keep the other k0 (and bins) of a previous run; the requested ones are replaced
+        requested = pd.DataFrame([(k0, eps) for k0 in k0s for eps in bins], columns=["k0", "eps"])
+        table = merged(out, pd.DataFrame(rows), ["k0", "eps"], replace=requested)[columns]
+        table = table.sort_values(["k0", "eps"], ascending=[False, False], ignore_index=True)
     table["reference"] = [micro.sigma_fast_limit(micro.Model(k0=k0), V) if k0 <= 0.01 else math.nan
                           for k0, V in zip(table.k0, table.V)]
     table["weakening"] = [micro.sigma_fast_limit(micro.Model(k0=k0), V) - micro.sigma_fast_limit(micro.Model(k0=k0))

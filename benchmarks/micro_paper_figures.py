@@ -41,15 +41,11 @@ import pandas as pd
 from scipy.optimize import curve_fit
 
 import micro
-from _budget import capped_t_max
+from _budget import K0, VC_RS, capped_t_max, merged
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "data"
 FIGS = ROOT / "docs" / "figures"
-K0 = (0.3, 0.1, 0.01, 0.001, 0.0001)
-#: RS critical velocity with the paper's A, B, D_c (Eq. (12)); micro's lies within ~20 %
-#: where measured (docs/compare.md): the diagram's velocities are placed around it
-VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51, 0.001: 116.5, 0.0001: 1167.0}
 RATIOS = (0.03, 0.1, 0.3, 0.6, 0.85, 1.2, 2.0, 5.0)
 
 
@@ -106,14 +102,9 @@ def fig4(eps: float, budget: float, k0s, ratios=RATIOS, t_max: float | None = No
             rows.append(row)
             print(f"fig 4: k0 = {k0:g}, V = {V:.4g}: {row['regime']} converged={row['converged']} "
                   f"{row['sigma_max']:.5f}/{row['sigma_min']:.5f} in {row['wall_time']:.1f} s", flush=True)
-            new = pd.DataFrame(rows)
-            # keep what is done, replacing the same points of a previous run (read now:
-            # another run may have added points meanwhile)
-            old = pd.read_csv(out) if out.exists() else pd.DataFrame(columns=["k0", "V"])
-            same = (np.isclose(old.k0.to_numpy(float)[:, None], new.k0.to_numpy(float))
-                    & np.isclose(old.V.to_numpy(float)[:, None], new.V.to_numpy(float))).any(axis=1)
-            data = pd.concat([old[~same], new]).sort_values(["k0", "V"], ascending=[False, True], ignore_index=True)
-            data.to_csv(out, index=False)
+            # keep what is done, replacing the same points of a previous run
+            data = merged(out, pd.DataFrame(rows), ["k0", "V"])
+            data.sort_values(["k0", "V"], ascending=[False, True]).to_csv(out, index=False)
     data = pd.read_csv(out)
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for k0, d in data.groupby("k0", sort=False):

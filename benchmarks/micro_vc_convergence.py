@@ -20,9 +20,9 @@ from pathlib import Path
 import pandas as pd
 
 import micro
+from _budget import VC_RS, merged
 
 HERE = Path(__file__).resolve().parent
-VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51}
 
 
 def main() -> None:
@@ -44,9 +44,7 @@ def main() -> None:
                              wall_s=time.perf_counter() - t))
             print(f"k0 = {k0:g}, eps = {eps:g}: Vc = {crit.Vc:.4f} [{crit.V_low:.4f}, {crit.V_high:.4f}] "
                   f"({crit.status}; {len(evals)} runs, {unconverged} unconverged; {rows[-1]['wall_s']:.0f} s)", flush=True)
-            old = pd.read_csv(out) if out.exists() else pd.DataFrame(columns=["k0", "eps"])
-            same = (old.k0 == k0) & (old.eps == eps)
-            pd.concat([old[~same], pd.DataFrame(rows[-1:])], ignore_index=True).to_csv(out, index=False)
+            merged(out, pd.DataFrame(rows[-1:]), ["k0", "eps"]).to_csv(out, index=False)
     print(pd.read_csv(out).to_string(index=False))
 
 
