@@ -4,7 +4,8 @@ V^c comes from `micro.critical_velocity`, the paper's bisection on the regime (1
 Near V^c the finite-eps dynamics is a noisy oscillation a few grid resolutions (k0 eps)
 wide, so the regime labels there, and the bisection, depend on eps; this script measures
 by how much, and whether V^c settles as eps shrinks.  Each bisection starts from the same
-guess (the RS V^c of Eq. (12) with the paper's A, B, D_c).
+guess (the RS V^c of Eq. (12) with the paper's A, B, D_c).  The independent check is
+`micro_hopf_amplitude.py` (cycle amplitudes of both solvers against V).
 
 Writes benchmarks/results/micro_vc_convergence.csv.
 
@@ -40,10 +41,14 @@ def main() -> None:
             crit = micro.critical_velocity(model, V_guess=VC_RS[k0], factor=1.5, numerics=micro.Numerics(eps=eps))
             evals = pd.DataFrame(crit.evaluations)
             unconverged = int((~evals.converged.astype(bool)).sum())
+            grid_cycles = int(((evals.regime == "stick-slip") & (evals.label == "steady")).sum())
             rows.append(dict(crit.to_dict(), eps=eps, evaluations=len(evals), unconverged=unconverged,
-                             wall_s=time.perf_counter() - t))
+                             grid_cycles=grid_cycles, wall_s=time.perf_counter() - t))
+            print(evals[["V", "regime", "label", "started_from", "sigma_max", "sigma_min", "converged", "t_end",
+                         "wall_time"]].to_string(index=False), flush=True)
             print(f"k0 = {k0:g}, eps = {eps:g}: Vc = {crit.Vc:.4f} [{crit.V_low:.4f}, {crit.V_high:.4f}] "
-                  f"({crit.status}; {len(evals)} runs, {unconverged} unconverged; {rows[-1]['wall_s']:.0f} s)", flush=True)
+                  f"({crit.status}; {len(evals)} runs, {unconverged} unconverged, {grid_cycles} cycles below "
+                  f"the grid's resolution; {rows[-1]['wall_s']:.0f} s)", flush=True)
             merged(out, pd.DataFrame(rows[-1:]), ["k0", "eps"]).to_csv(out, index=False)
     print(pd.read_csv(out).to_string(index=False))
 

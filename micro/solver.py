@@ -495,6 +495,15 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
 
 
 # ------------------------------------------------------------------------------ critical velocity
+def _bisection_label(res: Stationary) -> str:
+    """The regime the bisection goes by: a cycle whose stress drop is below
+    ``MARGINAL_CYCLE * k0 * eps`` counts as steady (the grid cannot tell it from its own
+    oscillations, whose amplitude scales with eps)."""
+    if res.regime == "stick-slip" and res.sigma_max - res.sigma_min < MARGINAL_CYCLE * _jitter(res.model, res.eps):
+        return "steady"
+    return res.regime
+
+
 def critical_velocity(
     model: Model,
     *,
@@ -514,6 +523,17 @@ def critical_velocity(
     system is steady already at ``V_min`` (e.g. ``k0 >= k2``), ``Vc`` is reported as 0
     with status ``"no stick-slip"``; if it is stick-slip at ``V_max``, as ``inf`` with
     status ``"above range"``.
+
+    V^c is where steady sliding loses stability, and each evaluation is decided from
+    close to it: a run below the slowest velocity found steady so far starts from that
+    run's final density (a small velocity step from a steady state), not from a fresh
+    one whose large transient decays ever more slowly near V^c.  A cycle counts as
+    stick-slip only if its stress drop is at least ``MARGINAL_CYCLE`` times the grid's
+    resolution ``k0 * eps``: near V^c the grid itself sustains oscillations of a few
+    ``k0 * eps`` (their amplitude scales with eps), which the bisection would otherwise
+    take for stick-slip.  The bisection's V^c therefore approaches the model's from
+    below as eps shrinks (docs/micro_numerics.md, section 4).  ``evaluations`` records
+    each run, with the ``label`` the bisection used and the velocity it ``started_from``.
     """
     V_min = _check_velocity(V_min, "V_min")
     V_max = _check_velocity(V_max, "V_max")
@@ -527,6 +547,7 @@ def critical_velocity(
     evaluations: list[dict] = []
 
     convergence = convergence or Convergence()
+    slowest_steady: dict = {"V": math.inf, "grid": None}
 
     def regime(V: float) -> str:
         conv = convergence
@@ -537,10 +558,15 @@ def critical_velocity(
             tau_u, _, tau_load = _time_scales(model, V)
             t_max = max(100.0 * tau_u if math.isfinite(tau_u) else 0.0, 30.0 * tau_load)
             conv = Convergence(rtol=conv.rtol, atol=conv.atol, n=conv.n, t_max=t_max)
-        res = stationary(model, V, numerics=numerics, convergence=conv)
-        evaluations.append(res.to_dict())
-        log.info("bisection k0=%g V=%.6g -> %s (%s)", model.k0, V, res.regime, res.message)
-        return res.regime
+        started_from = slowest_steady["V"] if V < slowest_steady["V"] and slowest_steady["grid"] is not None else math.nan
+        res = stationary(model, V, numerics=numerics, convergence=conv, keep_grid=True,
+                         initial=slowest_steady["grid"] if math.isfinite(started_from) else "auto")
+        label = _bisection_label(res)
+        if label == "steady" and V < slowest_steady["V"]:
+            slowest_steady.update(V=V, grid=res.grid)
+        evaluations.append(dict(res.to_dict(), label=label, started_from=started_from))
+        log.info("bisection k0=%g V=%.6g -> %s (%s)", model.k0, V, label, res.message)
+        return label
 
     # Bracket by expanding geometrically from V_guess: evaluations far from V^c are
     # the expensive ones (cost grows like V at large V and like 1/V at small V).

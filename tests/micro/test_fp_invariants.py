@@ -3,10 +3,14 @@ density, a stress that only falls while the drive holds still, and the renewal l
 (k2 = 0), where the stationary stress is known in closed form for any g."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
+import pandas as pd
 import pytest
 
 import micro
+from micro import solver
 
 FAST = micro.Numerics(eps=0.016)
 
@@ -122,7 +126,35 @@ def test_a_cycle_of_grid_size_is_flagged():
     res = micro.stationary(micro.Model(k0=0.01), 1000.0, numerics=micro.Numerics(eps=0.025))
     assert res.regime == "stick-slip" and res.converged
     assert "oscillation of the grid" in res.message
+    # ... and the critical-velocity bisection does not count it as stick-slip
+    assert solver._bisection_label(res) == "steady"
     # a real cycle (k0 = 0.1, V = 0.05: stress drop ~ 40 k0 eps) is not flagged
     real = micro.stationary(micro.Model(k0=0.1), 0.05, numerics=micro.Numerics(eps=0.016))
     assert real.regime == "stick-slip" and real.converged
     assert "grid" not in real.message
+    assert solver._bisection_label(real) == "stick-slip"
+
+
+def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state():
+    # Below the slowest velocity found steady so far, a run starts from that run's final
+    # density (a small step down from steady sliding), and a cycle counts only above the
+    # grid's resolution.  (Coarse bin, for speed: here V^c ~ 0.45; at eps = 0.016 and
+    # 0.008 it is 0.76 and 0.80, benchmarks/micro_vc_convergence.py.)
+    model = micro.Model(k0=0.1)
+    eps = 0.024
+    crit = micro.critical_velocity(model, V_guess=1.0, factor=1.5, rel_tol=0.05, numerics=micro.Numerics(eps=eps))
+    assert crit.status == "converged" and crit.V_low < crit.Vc < crit.V_high
+    evals = pd.DataFrame(crit.evaluations)
+    slowest = math.inf
+    for e in evals.itertuples():
+        if math.isfinite(slowest) and e.V < slowest:
+            assert e.started_from == slowest
+        else:
+            assert math.isnan(e.started_from)
+        if e.label == "steady":
+            slowest = min(slowest, e.V)
+        else:
+            assert e.sigma_max - e.sigma_min >= solver.MARGINAL_CYCLE * model.k0 * eps
+    assert (evals.label == "steady").any() and (evals.label == "stick-slip").any()
+    assert evals.set_index("V").label[crit.V_low] == "stick-slip"
+    assert evals.set_index("V").label[crit.V_high] == "steady"

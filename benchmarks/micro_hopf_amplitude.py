@@ -1,0 +1,103 @@
+"""Oscillation amplitude against V near V^c: Fokker-Planck at several bins against the N-block.
+
+Both solvers start from their steady state at V = 2 (above V^c) and are stepped down to
+each V, the small perturbation from which the critical velocity is defined.  The
+amplitude is the median, over windows of `--window` time units after the first, of the
+peak-to-peak stress in the window.  A physical cycle has the same amplitude at every bin
+and N; an oscillation of the grid scales with eps (it is a few k0 * eps), and the
+N-block's finite-N noise falls like N^-1/2.  This is the independent check of the
+bisection's V^c (`micro.critical_velocity`).
+
+Writes benchmarks/results/micro_hopf_amplitude.csv (rows merge by k0, resolution and V; a bin eps < 1 never equals an N).
+
+    python benchmarks/micro_hopf_amplitude.py                              # k0 = 0.1
+    python benchmarks/micro_hopf_amplitude.py --solver fp --eps 0.004 --V 0.8,0.9
+    python benchmarks/micro_hopf_amplitude.py --solver nblock --N 1e6 --t-max 60
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+import micro
+from _budget import merged
+from micro.nblock import simulate_nblock
+
+HERE = Path(__file__).resolve().parent
+V_START = 2.0
+
+
+def amplitude(t: np.ndarray, smax: np.ndarray, smin: np.ndarray, window: float, t_max: float) -> tuple[float, float]:
+    """Median and largest peak-to-peak stress over the windows after the first."""
+    pp = []
+    for a in np.arange(window, t_max - 0.5 * window, window):
+        m = (t >= a) & (t < a + window)
+        if m.any():
+            pp.append(float(smax[m].max() - smin[m].min()))
+    return float(np.median(pp)), float(np.max(pp))
+
+
+def fp_rows(model: micro.Model, eps: float, Vs: list[float], t_max: float, window: float) -> list[dict]:
+    num = micro.Numerics(eps=eps)
+    base = micro.stationary(model, V_START, numerics=num, keep_grid=True)
+    rows = []
+    for V in Vs:
+        t = time.perf_counter()
+        r = micro.simulate(model, V, duration=t_max, numerics=num, initial=base.grid,
+                           record_dsigma=0.25 * model.k0 * eps, record_dt=window / 200.0).records
+        med, top = amplitude(r.t.to_numpy(), r.sigma_max.to_numpy(), r.sigma_min.to_numpy(), window, t_max)
+        rows.append(dict(solver="fp", resolution=eps, V=V, amplitude=med, amplitude_max=top,
+                         in_k0_eps=med / (model.k0 * eps), t_max=t_max, wall_s=time.perf_counter() - t))
+        print(rows[-1], flush=True)
+    return rows
+
+
+def nblock_rows(model: micro.Model, N: int, Vs: list[float], t_max: float, window: float) -> list[dict]:
+    base = simulate_nblock(model, V_START, N, t_max=30.0, initial="frozen")
+    rows = []
+    for V in Vs:
+        t = time.perf_counter()
+        r = simulate_nblock(model, V, N, t_max=t_max, initial=base.final_state, record_every=window / 500.0).timeseries
+        med, top = amplitude(r.t.to_numpy(), r.sigma_max.to_numpy(), r.sigma_min.to_numpy(), window, t_max)
+        rows.append(dict(solver="nblock", resolution=float(N), V=V, amplitude=med, amplitude_max=top,
+                         in_k0_eps=np.nan, t_max=t_max, wall_s=time.perf_counter() - t))
+        print(rows[-1], flush=True)
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--k0", type=float, default=0.1)
+    ap.add_argument("--solver", choices=("fp", "nblock", "both"), default="both")
+    ap.add_argument("--eps", type=str, default="0.016,0.008", help="comma-separated FP bins")
+    ap.add_argument("--N", type=str, default="1e5", help="comma-separated N-block sizes")
+    ap.add_argument("--V", type=str, default="0.6,0.7,0.8,0.9,1.0,1.2", help="comma-separated velocities")
+    ap.add_argument("--t-max", type=float, default=120.0, help="simulated time per velocity")
+    ap.add_argument("--window", type=float, default=10.0, help="amplitude window (time units)")
+    args = ap.parse_args()
+    model = micro.Model(k0=args.k0)
+    Vs = [float(v) for v in args.V.split(",")]
+    out = HERE / "results" / "micro_hopf_amplitude.csv"
+    runs = []
+    if args.solver in ("fp", "both"):
+        runs += [("fp", float(e)) for e in args.eps.split(",")]
+    if args.solver in ("nblock", "both"):
+        runs += [("nblock", float(n)) for n in args.N.split(",")]
+    for solver, res in runs:
+        if solver == "fp":
+            rows = fp_rows(model, res, Vs, args.t_max, args.window)
+        else:
+            rows = nblock_rows(model, int(res), Vs, args.t_max, args.window)
+        new = pd.DataFrame(rows).assign(k0=args.k0)
+        merged(out, new, ["k0", "resolution", "V"]).to_csv(out, index=False)
+    table = pd.read_csv(out).sort_values(["k0", "V", "solver", "resolution"])
+    print(table.pivot_table(index=["k0", "V"], columns=["solver", "resolution"], values="amplitude").to_string(
+        float_format=lambda x: f"{x:.4f}"))
+
+
+if __name__ == "__main__":
+    main()
