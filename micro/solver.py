@@ -478,6 +478,10 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
             detail = f"; the oscillation decays towards a cycle of amplitude {limit:.3g} (stick-slip attractor)"
         else:
             detail = f"; the oscillation persists (amplitude ratio {ratio:.4f} per cycle)"
+        drop = float((last.sigma_max - last.sigma_min).mean())
+        if drop < MARGINAL_CYCLE * 0.5 * hysteresis:  # (hysteresis = 2 k0 eps)
+            detail += (f"; its stress drop {drop:.3g} is only {2.0 * drop / hysteresis:.2g} k0*eps: it may be an "
+                       f"oscillation of the grid")
         return "stick-slip", why + detail, dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
                                                 sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
     sigma = rec.time_mean(t_now - span, t_now)

@@ -158,3 +158,23 @@ def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state():
     assert (evals.label == "steady").any() and (evals.label == "stick-slip").any()
     assert evals.set_index("V").label[crit.V_low] == "stick-slip"
     assert evals.set_index("V").label[crit.V_high] == "steady"
+
+
+@pytest.mark.parametrize("drop_in_k0_eps, flagged", [(4.0, True), (40.0, False)])
+def test_a_persisting_unconverged_oscillation_of_grid_size_is_flagged(drop_in_k0_eps, flagged):
+    # A run cut off at t_max with an oscillation that neither grows nor decays is called
+    # stick-slip; below 10 k0 eps it must also say that it may be the grid's own.
+    from micro import _kernels as K
+    from micro.analysis import Records, find_cycles
+
+    jitter = 1e-3  # k0 * eps
+    t = np.linspace(0.0, 100.0, 20001)
+    s = 0.9 + 0.5 * drop_in_k0_eps * jitter * np.sin(2.0 * np.pi * t / 5.0)
+    rec = Records.from_array(np.column_stack([t, s, s, s, s]))
+    cycles = find_cycles(rec, 2.0 * jitter)
+    assert len(cycles) >= 3
+    regime, message, out = solver._unconverged(rec, cycles, 2.0 * jitter, 100.0, 5.0, 100.0, 100.0, K.DONE,
+                                               load_rate=1e-3)
+    assert regime == "stick-slip" and "persists" in message
+    assert ("oscillation of the grid" in message) == flagged
+    assert out["sigma_max"] - out["sigma_min"] == pytest.approx(drop_in_k0_eps * jitter, rel=1e-3)
