@@ -133,6 +133,8 @@ class Stationary:
     ``sigma_max``, ``sigma_min`` and ``sigma_mean`` are equal on steady rows;
     ``sigma_stderr`` is the statistical error of ``sigma_mean`` from the discretisation
     jitter (the solver is deterministic, but its stress jitters at the scale k0 * eps).
+    ``shocks_per_cycle`` counts the global shocks (cascades of more than 8 bins) per
+    cycle of a stick-slip result.
     ``converged`` says whether the stopping test was met; ``message`` says why the run
     ended.  ``mass_error`` (|total probability - 1|) and ``min_mass`` (the most negative
     cell mass ever seen, 0 if none) are the solver's own checks of the density.
@@ -153,6 +155,7 @@ class Stationary:
     n_cycles: int
     wall_time: float
     sigma_stderr: float = math.nan
+    shocks_per_cycle: float = math.nan
     mass_error: float = math.nan
     min_mass: float = math.nan
     records: pd.DataFrame | None = field(default=None, repr=False)
@@ -164,7 +167,8 @@ class Stationary:
         return {
             "k0": m.k0, "k1": m.k1, "k2": m.k2, "zbar": m.zbar, "V": self.V, "regime": self.regime,
             "sigma_max": self.sigma_max, "sigma_min": self.sigma_min, "sigma_mean": self.sigma_mean,
-            "period": self.period, "sigma_stderr": self.sigma_stderr, "converged": self.converged,
+            "period": self.period, "sigma_stderr": self.sigma_stderr, "shocks_per_cycle": self.shocks_per_cycle,
+            "converged": self.converged,
             "message": self.message,
             "eps": self.eps, "t_end": self.t_end, "n_cycles": self.n_cycles, "wall_time": self.wall_time,
             "mass_error": self.mass_error, "min_mass": self.min_mass,
@@ -233,10 +237,23 @@ def _time_scales(model: Model, V: float) -> tuple[float, float, float]:
     return tau_u, tau_c, tau_load
 
 
-#: A converged cycle whose stress drop is below this many k0 * eps may be an oscillation
-#: of the discretisation: seen with drops of 2.2-5.6 k0 eps at large V (k0 = 1e-3,
-#: V = 175; k0 = 0.01, V = 1000), amplitudes falling like eps^2 (docs/micro_results.md).
+#: A cycle without global shocks whose stress drop is below this many k0 * eps may be an
+#: oscillation of the discretisation: seen with drops of 2.2-5.6 k0 eps at large V
+#: (k0 = 1e-3, V = 175; k0 = 0.01, V = 1000), amplitudes falling like eps^2, and of up to
+#: 10 k0 eps near V^c, amplitudes ~ eps (docs/micro_results.md, micro_numerics.md).
 MARGINAL_CYCLE = 10.0
+
+
+def _grid_sized(drop: float, shocks_per_cycle: float, jitter: float) -> bool:
+    """Whether a cycle may be the grid's own oscillation: smooth (no global shock, which
+    drops the stress by more than 8 k0 eps at once) and below ``MARGINAL_CYCLE`` jitters."""
+    return drop < MARGINAL_CYCLE * jitter and not shocks_per_cycle > 0.0
+
+
+def _shocks_per_cycle(shock_times: np.ndarray, cycles: pd.DataFrame) -> float:
+    """Global shocks per cycle over ``cycles`` (from the first peak to the last)."""
+    t0, t1 = float(cycles.t_start.iloc[0]), float(cycles.t_end.iloc[-1])
+    return float(np.count_nonzero((shock_times >= t0) & (shock_times < t1)) / len(cycles))
 
 
 # ------------------------------------------------------------------------------ simulate
@@ -369,13 +386,14 @@ def stationary(
             regime, converged = "stick-slip", True
             message = f"limit cycle converged over {n} cycles"
             drop = float((last.sigma_max - last.sigma_min).mean())
-            if drop < MARGINAL_CYCLE * jitter:
+            per_cycle = _shocks_per_cycle(_shock_times(shock_rows), last)
+            if _grid_sized(drop, per_cycle, jitter):
                 message += (f"; its stress drop {drop:.3g} is only {drop / jitter:.2g} k0*eps: it may be an "
                             f"oscillation of the grid (theirs fall like eps^2), confirm at a finer eps")
                 log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
             out = dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
                        sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
-                       sigma_stderr=float(last.sigma_mean.std(ddof=1) / math.sqrt(n)))
+                       sigma_stderr=float(last.sigma_mean.std(ddof=1) / math.sqrt(n)), shocks_per_cycle=per_cycle)
             break
         # --- a steady state?  No cycle in the last n spans, and span means that agree
         # within the tolerance plus their own statistical error (the jitter).
@@ -401,7 +419,7 @@ def stationary(
                 break
         if elapsed >= t_max or code != K.DONE:
             regime, message, out = _unconverged(rec, cycles, hysteresis, t_now, span, elapsed, t_max, code,
-                                                load_rate=model.k0 * V)
+                                                load_rate=model.k0 * V, shock_times=_shock_times(shock_rows))
             break
         # lengthen the chunks while no cycle has shown up (slow stick-slip)
         if len(cycles) == 0:
@@ -454,8 +472,13 @@ def _span_means(rec: Records, start: float, span: float, n: int, parts: int = 8)
     return means, errors
 
 
+def _shock_times(shock_rows: list[np.ndarray]) -> np.ndarray:
+    return np.concatenate([s[:, 0] for s in shock_rows]) if shock_rows else np.zeros(0)
+
+
 def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: float, span: float,
-                 elapsed: float, t_max: float, code: int, load_rate: float) -> tuple[str, str, dict]:
+                 elapsed: float, t_max: float, code: int, load_rate: float,
+                 shock_times: np.ndarray = np.zeros(0)) -> tuple[str, str, dict]:
     """Regime and best estimates of a run that did not meet its stopping test."""
     why = f"not converged by t_max = {t_max:.4g}" if code == K.DONE else f"stopped early (kernel code {code})"
     if len(cycles) >= 3:
@@ -479,11 +502,13 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
         else:
             detail = f"; the oscillation persists (amplitude ratio {ratio:.4f} per cycle)"
         drop = float((last.sigma_max - last.sigma_min).mean())
-        if drop < MARGINAL_CYCLE * 0.5 * hysteresis:  # (hysteresis = 2 k0 eps)
+        per_cycle = _shocks_per_cycle(shock_times, last)
+        if _grid_sized(drop, per_cycle, 0.5 * hysteresis):  # (hysteresis = 2 k0 eps)
             detail += (f"; its stress drop {drop:.3g} is only {2.0 * drop / hysteresis:.2g} k0*eps: it may be an "
                        f"oscillation of the grid")
         return "stick-slip", why + detail, dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
-                                                sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()))
+                                                sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
+                                                shocks_per_cycle=per_cycle)
     sigma = rec.time_mean(t_now - span, t_now)
     lo = rec.since(t_now - span)
     amplitude = float(lo.sigma_max.max() - lo.sigma_min.min()) if len(lo) else math.nan
@@ -500,10 +525,11 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
 
 # ------------------------------------------------------------------------------ critical velocity
 def _bisection_label(res: Stationary) -> str:
-    """The regime the bisection goes by: a cycle whose stress drop is below
-    ``MARGINAL_CYCLE * k0 * eps`` counts as steady (the grid cannot tell it from its own
-    oscillations, whose amplitude scales with eps)."""
-    if res.regime == "stick-slip" and res.sigma_max - res.sigma_min < MARGINAL_CYCLE * _jitter(res.model, res.eps):
+    """The regime the bisection goes by: a smooth cycle (no global shock) whose stress
+    drop is below ``MARGINAL_CYCLE * k0 * eps`` counts as steady (the grid cannot tell it
+    from its own oscillations, whose amplitude scales with eps)."""
+    if res.regime == "stick-slip" and _grid_sized(res.sigma_max - res.sigma_min, res.shocks_per_cycle,
+                                                  _jitter(res.model, res.eps)):
         return "steady"
     return res.regime
 
@@ -532,11 +558,12 @@ def critical_velocity(
     close to it: a run below the slowest velocity found steady so far starts from that
     run's final density (a small velocity step from a steady state), not from a fresh
     one whose large transient decays ever more slowly near V^c.  A cycle counts as
-    stick-slip only if its stress drop is at least ``MARGINAL_CYCLE`` times the grid's
-    resolution ``k0 * eps``: near V^c the grid itself sustains oscillations of a few
-    ``k0 * eps`` (their amplitude scales with eps), which the bisection would otherwise
-    take for stick-slip.  The bisection's V^c therefore approaches the model's from
-    below as eps shrinks (docs/micro_numerics.md, section 4).  ``evaluations`` records
+    stick-slip only if it has global shocks or its stress drop is at least
+    ``MARGINAL_CYCLE`` times the grid's resolution ``k0 * eps``: near V^c the grid
+    itself sustains smooth oscillations of a few ``k0 * eps`` (their amplitude scales
+    with eps), which the bisection would otherwise take for stick-slip.  Measured at
+    k0 = 0.1, the bisection's V^c approaches the model's from below as eps shrinks
+    (docs/micro_numerics.md, section 4).  ``evaluations`` records
     each run, with the ``label`` the bisection used and the velocity it ``started_from``.
     """
     V_min = _check_velocity(V_min, "V_min")

@@ -133,6 +133,20 @@ def test_a_cycle_of_grid_size_is_flagged():
     assert real.regime == "stick-slip" and real.converged
     assert "grid" not in real.message
     assert solver._bisection_label(real) == "stick-slip"
+    assert res.shocks_per_cycle == 0.0 and real.shocks_per_cycle >= 1.0
+
+
+def test_a_small_cycle_with_global_shocks_is_not_taken_for_the_grid():
+    # k0 = 0.3 at the coarse bin of the phase diagram: real stick-slip (one global shock
+    # per cycle) whose stress drop, 0.072, is only 9.5 k0 eps.  Going by the drop alone
+    # flagged it, and the bisection would have called it steady.
+    model = micro.Model(k0=0.3)
+    res = micro.stationary(model, 0.00685, numerics=micro.Numerics(eps=0.025))
+    assert res.regime == "stick-slip" and res.converged
+    assert res.sigma_max - res.sigma_min < solver.MARGINAL_CYCLE * model.k0 * 0.025
+    assert res.shocks_per_cycle >= 1.0
+    assert "grid" not in res.message
+    assert solver._bisection_label(res) == "stick-slip"
 
 
 def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state():
