@@ -238,17 +238,24 @@ def _time_scales(model: Model, V: float) -> tuple[float, float, float]:
     return tau_u, tau_c, tau_load
 
 
-#: A cycle without global shocks whose stress drop is below this many k0 * eps may be an
-#: oscillation of the discretisation: seen with drops of 2.2-5.6 k0 eps at large V
-#: (k0 = 1e-3, V = 175; k0 = 0.01, V = 1000), amplitudes falling like eps^2, and of up to
-#: 10 k0 eps near V^c, amplitudes ~ eps (docs/micro_results.md, micro_numerics.md).
+#: A cycle without global shocks whose stress drop is below this many k0 * eps, or
+#: below GRID_CYCLE_EPS * eps, may be an oscillation of the discretisation: seen with drops
+#: of 2.2-5.6 k0 eps at large V (k0 = 1e-3, V = 175; k0 = 0.01, V = 1000), amplitudes
+#: falling like eps^2, and near V^c of up to 1.6 eps (eps = 0.016) and 1.9 eps (0.008)
+#: at both k0 = 0.1 and 0.3, amplitudes ~ eps (docs/micro_results.md, micro_numerics.md §5).
 MARGINAL_CYCLE = 10.0
+GRID_CYCLE_EPS = 2.0
 
 
-def _grid_sized(drop: float, shocks_per_cycle: float, jitter: float) -> bool:
-    """Whether a cycle may be the grid's own oscillation: smooth (no global shock, which
-    drops the stress by more than 8 k0 eps at once) and below ``MARGINAL_CYCLE`` jitters."""
-    return drop < MARGINAL_CYCLE * jitter and not shocks_per_cycle > 0.0
+def _grid_limit(model: Model, eps: float) -> float:
+    """Stress drop below which a smooth cycle may be the grid's own oscillation."""
+    return min(MARGINAL_CYCLE * _jitter(model, eps), GRID_CYCLE_EPS * eps)
+
+
+def _grid_sized(drop: float, shocks_per_cycle: float, limit: float) -> bool:
+    """Whether a cycle may be the grid's own oscillation: smooth (no global shock, a
+    cascade of more than 8 bins) and a stress drop below ``limit`` (:func:`_grid_limit`)."""
+    return drop < limit and not shocks_per_cycle > 0.0
 
 
 def _shocks_per_cycle(shock_times: np.ndarray, cycles: pd.DataFrame) -> float:
@@ -388,9 +395,10 @@ def stationary(
             message = f"limit cycle converged over {n} cycles"
             drop = float((last.sigma_max - last.sigma_min).mean())
             per_cycle = _shocks_per_cycle(_shock_times(shock_rows), last)
-            if _grid_sized(drop, per_cycle, jitter):
-                message += (f"; its stress drop {drop:.3g} is only {drop / jitter:.2g} k0*eps: it may be an "
-                            f"oscillation of the grid (theirs shrink with eps), confirm at a finer eps")
+            if _grid_sized(drop, per_cycle, _grid_limit(model, settings.eps)):
+                message += (f"; its stress drop {drop:.3g} is only {drop / jitter:.2g} k0*eps, without global "
+                            f"shocks: it may be an oscillation of the grid (theirs shrink with eps), confirm at "
+                            f"a finer eps")
                 log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
             out = dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
                        sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
@@ -420,7 +428,8 @@ def stationary(
                 break
         if elapsed >= t_max or code != K.DONE:
             regime, message, out = _unconverged(rec, cycles, hysteresis, t_now, span, elapsed, t_max, code,
-                                                load_rate=model.k0 * V, shock_times=_shock_times(shock_rows))
+                                                load_rate=model.k0 * V, shock_times=_shock_times(shock_rows),
+                                                grid_limit=_grid_limit(model, settings.eps))
             break
         # lengthen the chunks while no cycle has shown up (slow stick-slip)
         if len(cycles) == 0:
@@ -499,8 +508,9 @@ def _shock_times(shock_rows: list[np.ndarray]) -> np.ndarray:
 
 def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: float, span: float,
                  elapsed: float, t_max: float, code: int, load_rate: float,
-                 shock_times: np.ndarray | None = None) -> tuple[str, str, dict]:
-    """Regime and best estimates of a run that did not meet its stopping test."""
+                 shock_times: np.ndarray | None = None, grid_limit: float = 0.0) -> tuple[str, str, dict]:
+    """Regime and best estimates of a run that did not meet its stopping test (cycles
+    smaller than ``grid_limit`` without shocks are flagged as possibly the grid's)."""
     why = f"not converged by t_max = {t_max:.4g}" if code == K.DONE else f"stopped early (kernel code {code})"
     if len(cycles) >= 3:
         amp = (cycles.sigma_max - cycles.sigma_min).to_numpy()
@@ -524,9 +534,9 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
             detail = f"; the oscillation persists (amplitude ratio {ratio:.4f} per cycle)"
         drop = float((last.sigma_max - last.sigma_min).mean())
         per_cycle = _shocks_per_cycle(np.zeros(0) if shock_times is None else shock_times, last)
-        if _grid_sized(drop, per_cycle, 0.5 * hysteresis):  # (hysteresis = 2 k0 eps)
-            detail += (f"; its stress drop {drop:.3g} is only {2.0 * drop / hysteresis:.2g} k0*eps: it may be an "
-                       f"oscillation of the grid")
+        if _grid_sized(drop, per_cycle, grid_limit):  # (hysteresis = 2 k0 eps)
+            detail += (f"; its stress drop {drop:.3g} is only {2.0 * drop / hysteresis:.2g} k0*eps, without "
+                       f"global shocks: it may be an oscillation of the grid")
         return "stick-slip", why + detail, dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
                                                 sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
                                                 shocks_per_cycle=per_cycle)
@@ -547,10 +557,11 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
 # ------------------------------------------------------------------------------ critical velocity
 def _bisection_label(res: Stationary) -> str:
     """The regime the bisection goes by: a smooth cycle (no global shock) whose stress
-    drop is below ``MARGINAL_CYCLE * k0 * eps`` counts as steady (the grid cannot tell it
-    from its own oscillations, whose amplitude scales with eps)."""
+    drop is below ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS * eps)`` counts as
+    steady (the grid cannot tell it from its own oscillations, whose amplitude scales
+    with eps)."""
     if res.regime == "stick-slip" and _grid_sized(res.sigma_max - res.sigma_min, res.shocks_per_cycle,
-                                                  _jitter(res.model, res.eps)):
+                                                  _grid_limit(res.model, res.eps)):
         return "steady"
     return res.regime
 
@@ -580,7 +591,7 @@ def critical_velocity(
     run's final density (a small velocity step from a steady state), not from a fresh
     one whose large transient decays ever more slowly near V^c.  A cycle counts as
     stick-slip only if it has global shocks or its stress drop is at least
-    ``MARGINAL_CYCLE`` times the grid's resolution ``k0 * eps``: near V^c the grid
+    ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS * eps)``: near V^c the grid
     itself sustains smooth oscillations of a few ``k0 * eps`` (their amplitude scales
     with eps), which the bisection would otherwise take for stick-slip.  What remains
     is the discretisation error of the cycle itself near V^c, which falls only slowly

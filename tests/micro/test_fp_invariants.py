@@ -168,7 +168,7 @@ def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state():
         if e.label == "steady":
             slowest = min(slowest, e.V)
         else:
-            assert not solver._grid_sized(e.sigma_max - e.sigma_min, e.shocks_per_cycle, model.k0 * eps)
+            assert not solver._grid_sized(e.sigma_max - e.sigma_min, e.shocks_per_cycle, solver._grid_limit(model, eps))
     assert (evals.label == "steady").any() and (evals.label == "stick-slip").any()
     assert evals.set_index("V").label[crit.V_low] == "stick-slip"
     assert evals.set_index("V").label[crit.V_high] == "steady"
@@ -188,7 +188,7 @@ def test_a_persisting_unconverged_oscillation_of_grid_size_is_flagged(drop_in_k0
     cycles = find_cycles(rec, 2.0 * jitter)
     assert len(cycles) >= 3
     regime, message, out = solver._unconverged(rec, cycles, 2.0 * jitter, 100.0, 5.0, 100.0, 100.0, K.DONE,
-                                               load_rate=1e-3)
+                                               load_rate=1e-3, grid_limit=10.0 * jitter)
     assert regime == "stick-slip" and "persists" in message
     assert ("oscillation of the grid" in message) == flagged
     assert out["sigma_max"] - out["sigma_min"] == pytest.approx(drop_in_k0_eps * jitter, rel=1e-3)
