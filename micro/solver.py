@@ -258,6 +258,12 @@ def _grid_sized(drop: float, shocks_per_cycle: float, limit: float) -> bool:
     return drop < limit and not shocks_per_cycle > 0.0
 
 
+def _grid_note(drop: float, jitter: float) -> str:
+    """The message for a cycle that may be the grid's own oscillation."""
+    return (f"; its stress drop {drop:.3g} is only {drop / jitter:.2g} k0*eps, without global shocks: it may be "
+            f"an oscillation of the grid (theirs shrink with eps), confirm at a finer eps")
+
+
 def _shocks_per_cycle(shock_times: np.ndarray, cycles: pd.DataFrame) -> float:
     """Global shocks per cycle over ``cycles`` (from the first peak to the last)."""
     t0, t1 = float(cycles.t_start.iloc[0]), float(cycles.t_end.iloc[-1])
@@ -396,9 +402,7 @@ def stationary(
             drop = float((last.sigma_max - last.sigma_min).mean())
             per_cycle = _shocks_per_cycle(_shock_times(shock_rows), last)
             if _grid_sized(drop, per_cycle, _grid_limit(model, settings.eps)):
-                message += (f"; its stress drop {drop:.3g} is only {drop / jitter:.2g} k0*eps, without global "
-                            f"shocks: it may be an oscillation of the grid (theirs shrink with eps), confirm at "
-                            f"a finer eps")
+                message += _grid_note(drop, jitter)
                 log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
             out = dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
                        sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
@@ -534,9 +538,8 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
             detail = f"; the oscillation persists (amplitude ratio {ratio:.4f} per cycle)"
         drop = float((last.sigma_max - last.sigma_min).mean())
         per_cycle = _shocks_per_cycle(np.zeros(0) if shock_times is None else shock_times, last)
-        if _grid_sized(drop, per_cycle, grid_limit):  # (hysteresis = 2 k0 eps)
-            detail += (f"; its stress drop {drop:.3g} is only {2.0 * drop / hysteresis:.2g} k0*eps, without "
-                       f"global shocks: it may be an oscillation of the grid")
+        if _grid_sized(drop, per_cycle, grid_limit):
+            detail += _grid_note(drop, 0.5 * hysteresis)  # (hysteresis = 2 k0 eps)
         return "stick-slip", why + detail, dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
                                                 sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
                                                 shocks_per_cycle=per_cycle)
@@ -595,7 +598,7 @@ def critical_velocity(
     itself sustains smooth oscillations of a few ``k0 * eps`` (their amplitude scales
     with eps), which the bisection would otherwise take for stick-slip.  What remains
     is the discretisation error of the cycle itself near V^c, which falls only slowly
-    with eps (k0 = 0.1: V^c = 0.76, 0.80 at eps = 0.016, 0.008 against the N-block's
+    with eps (k0 = 0.1: V^c = 0.90, 0.84 at eps = 0.016, 0.008 against the N-block's
     0.70-0.75; docs/micro_numerics.md, section 5).  ``evaluations`` records
     each run, with the ``label`` the bisection used and the velocity it ``started_from``.
     """
