@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -559,14 +559,36 @@ def _unconverged(rec: Records, cycles: pd.DataFrame, hysteresis: float, t_now: f
 
 # ------------------------------------------------------------------------------ critical velocity
 def _bisection_label(res: Stationary) -> str:
-    """The regime the bisection goes by: a smooth cycle (no global shock) whose stress
-    drop is below ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS * eps)`` counts as
-    steady (the grid cannot tell it from its own oscillations, whose amplitude scales
-    with eps)."""
+    """The regime the bisection goes by without the check at a finer bin: a smooth cycle
+    (no global shock) whose stress drop is below ``min(MARGINAL_CYCLE * k0 * eps,
+    GRID_CYCLE_EPS * eps)`` counts as steady (the grid cannot tell it from its own
+    oscillations, whose amplitude scales with eps)."""
     if res.regime == "stick-slip" and _grid_sized(res.sigma_max - res.sigma_min, res.shocks_per_cycle,
                                                   _grid_limit(res.model, res.eps)):
         return "steady"
     return res.regime
+
+
+#: With ``refine``, an oscillation is taken for the grid's when its amplitude at eps / 2
+#: is below this fraction of its amplitude at eps.  Measured stepping down from steady
+#: sliding (docs/micro_numerics.md, section 5): physical cycles keep 0.77-1.0 of their
+#: amplitude when eps halves (k0 = 0.1, V <= 0.7; k0 = 0.3, V <= 0.15), the grid's keep
+#: 0.31-0.65 (k0 = 0.1, V >= 0.75; k0 = 0.3, V >= 0.2), where the N-block has no cycle.
+REFINE_RATIO = 0.7
+
+
+def _cycle_amplitude(res: Stationary) -> float:
+    """Median stress drop of the cycles in the later half of a run with records (0 for a
+    steady run, or with fewer than two cycles there)."""
+    if res.regime == "steady" or res.records is None or len(res.records) < 3:
+        return 0.0
+    r = res.records
+    rec = Records(*(r[c].to_numpy() for c in ("t", "sigma", "sigma_min", "sigma_max", "sigma_mean")))
+    rec = rec.since(0.5 * (rec.t[0] + rec.t[-1]))
+    cycles = find_cycles(rec, 2.0 * _jitter(res.model, res.eps))
+    if len(cycles) < 2:
+        return 0.0
+    return float(np.median(cycles.sigma_max - cycles.sigma_min))
 
 
 def critical_velocity(
@@ -579,6 +601,7 @@ def critical_velocity(
     rel_tol: float = 1e-2,
     numerics: Numerics | None = None,
     convergence: Convergence | None = None,
+    refine: bool = True,
 ) -> Critical:
     """Critical velocity by bisection on the regime (the paper's Appendix B).
 
@@ -592,15 +615,27 @@ def critical_velocity(
     V^c is where steady sliding loses stability, and each evaluation is decided from
     close to it: a run below the slowest velocity found steady so far starts from that
     run's final density (a small velocity step from a steady state), not from a fresh
-    one whose large transient decays ever more slowly near V^c.  A cycle counts as
-    stick-slip only if it has global shocks or its stress drop is at least
-    ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS * eps)``: near V^c the grid
-    itself sustains smooth oscillations of a few ``k0 * eps`` (their amplitude scales
-    with eps), which the bisection would otherwise take for stick-slip.  What remains
-    is the discretisation error of the cycle itself near V^c, which falls only slowly
-    with eps (k0 = 0.1: V^c = 0.90, 0.84 at eps = 0.016, 0.008 against the N-block's
-    0.70-0.75; docs/micro_numerics.md, section 5).  ``evaluations`` records
-    each run, with the ``label`` the bisection used and the velocity it ``started_from``.
+    one whose large transient decays ever more slowly near V^c.
+
+    Near V^c the grid itself sustains smooth oscillations of up to ~2 eps (the jitter of
+    the stress drives the weakly damped mode), which a bisection on the regime would
+    take for stick-slip.  With ``refine`` (the default) an oscillation whose median
+    stress drop is below ``GRID_CYCLE_EPS * eps`` is run again at eps / 2, stepped down
+    from steady sliding at eps / 2 in the same way, and counts as stick-slip only if it
+    keeps at least ``REFINE_RATIO`` (0.7) of its amplitude: a physical cycle converges
+    in eps, the grid's shrinks with it.  Each such check costs about ten runs at eps.
+    Measured against the N-block's V^c (0.70-0.75 at k0 = 0.1, 0.19-0.21 at k0 = 0.3):
+    0.729 and 0.186 at eps = 0.016 (docs/micro_numerics.md, section 5).  Without
+    ``refine`` a cycle counts as stick-slip only if it has global shocks or a stress drop
+    of at least ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS * eps)``, which is
+    cheaper but leaves V^c the discretisation error of the cycle near threshold
+    (k0 = 0.1: 0.90 and 0.84 at eps = 0.016 and 0.008) and, at coarse bins, takes small
+    physical cycles for the grid's.
+
+    ``evaluations`` records each run, with the ``label`` the bisection used, the
+    velocity it ``started_from``, its median cycle ``amplitude`` and, where checked,
+    ``amplitude_fine`` at eps / 2 and that run's ``wall_time_fine`` (NaN otherwise;
+    ``amplitude`` is NaN without ``refine``).
     """
     V_min = _check_velocity(V_min, "V_min")
     V_max = _check_velocity(V_max, "V_max")
@@ -614,7 +649,19 @@ def critical_velocity(
     evaluations: list[dict] = []
 
     convergence = convergence or Convergence()
+    numerics = numerics or Numerics()
+    eps = numerics.settings(model).eps
+    fine_numerics = replace(numerics, eps=0.5 * eps)
+    # the slowest velocity decided steady, with its final density, at eps and at eps / 2
     slowest_steady: dict = {"V": math.inf, "grid": None}
+    fine_steady: dict = {"V": math.inf, "grid": None}
+
+    def run(V: float, conv: Convergence, num: Numerics, chain: dict) -> tuple[Stationary, float]:
+        """A run at V, from the chain's steady state if it is faster than V."""
+        started_from = chain["V"] if V < chain["V"] and chain["grid"] is not None else math.nan
+        res = stationary(model, V, numerics=num, convergence=conv, keep_grid=True, keep_records=refine,
+                         initial=chain["grid"] if math.isfinite(started_from) else "auto")
+        return res, started_from
 
     def regime(V: float) -> str:
         conv = convergence
@@ -625,14 +672,31 @@ def critical_velocity(
             tau_u, _, tau_load = _time_scales(model, V)
             t_max = max(100.0 * tau_u if math.isfinite(tau_u) else 0.0, 30.0 * tau_load)
             conv = Convergence(rtol=conv.rtol, atol=conv.atol, n=conv.n, t_max=t_max)
-        started_from = slowest_steady["V"] if V < slowest_steady["V"] and slowest_steady["grid"] is not None else math.nan
-        res = stationary(model, V, numerics=numerics, convergence=conv, keep_grid=True,
-                         initial=slowest_steady["grid"] if math.isfinite(started_from) else "auto")
-        label = _bisection_label(res)
+        res, started_from = run(V, conv, numerics, slowest_steady)
+        amplitude, fine_amplitude, fine = math.nan, math.nan, None
+        if not refine:
+            label = _bisection_label(res)
+        else:
+            label = res.regime
+            amplitude = _cycle_amplitude(res)
+            if res.regime == "stick-slip" and amplitude < GRID_CYCLE_EPS * eps:
+                # too small to tell from the grid's own oscillation: does it survive at eps / 2?
+                if fine_steady["grid"] is None and math.isfinite(slowest_steady["V"]):
+                    base, _ = run(slowest_steady["V"], conv, fine_numerics, fine_steady)
+                    fine_steady.update(V=slowest_steady["V"], grid=base.grid)
+                fine, _ = run(V, conv, fine_numerics, fine_steady)
+                fine_amplitude = _cycle_amplitude(fine)
+                if fine_amplitude < REFINE_RATIO * amplitude:
+                    label = "steady"
+                    if V < fine_steady["V"]:
+                        fine_steady.update(V=V, grid=fine.grid)
         if label == "steady" and V < slowest_steady["V"]:
             slowest_steady.update(V=V, grid=res.grid)
-        evaluations.append(dict(res.to_dict(), label=label, started_from=started_from))
-        log.info("bisection k0=%g V=%.6g -> %s (%s)", model.k0, V, label, res.message)
+        evaluations.append(dict(res.to_dict(), label=label, started_from=started_from, amplitude=amplitude,
+                                amplitude_fine=fine_amplitude,
+                                wall_time_fine=fine.wall_time if fine is not None else math.nan))
+        log.info("bisection k0=%g V=%.6g -> %s (%s; amplitude %.3g, at eps/2 %.3g)", model.k0, V, label,
+                 res.message, amplitude, fine_amplitude)
         return label
 
     # Bracket by expanding geometrically from V_guess: evaluations far from V^c are

@@ -11,6 +11,7 @@ import pytest
 
 import micro
 from micro import solver
+from micro.nblock import simulate_nblock
 
 FAST = micro.Numerics(eps=0.016)
 
@@ -151,12 +152,13 @@ def test_a_small_cycle_with_global_shocks_is_not_taken_for_the_grid():
 
 def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state():
     # Below the slowest velocity found steady so far, a run starts from that run's final
-    # density (a small step down from steady sliding), and a cycle counts only above the
-    # grid's resolution.  (Coarse bin, for speed: here V^c ~ 0.87; finer bins in
-    # benchmarks/micro_vc_convergence.py.)
+    # density (a small step down from steady sliding), and without the check at eps / 2 a
+    # cycle counts only above the grid's resolution.  (Coarse bin, for speed: here
+    # V^c ~ 0.87; finer bins in benchmarks/micro_vc_convergence.py.)
     model = micro.Model(k0=0.1)
     eps = 0.024
-    crit = micro.critical_velocity(model, V_guess=1.0, factor=1.5, rel_tol=0.05, numerics=micro.Numerics(eps=eps))
+    crit = micro.critical_velocity(model, V_guess=1.0, factor=1.5, rel_tol=0.05, numerics=micro.Numerics(eps=eps),
+                                   refine=False)
     assert crit.status == "converged" and crit.V_low < crit.Vc < crit.V_high
     evals = pd.DataFrame(crit.evaluations)
     slowest = math.inf
@@ -208,3 +210,51 @@ def test_a_fluctuating_cycle_is_not_a_decaying_one():
     assert decays and ratio == pytest.approx(0.99, abs=2e-3)
     # few cycles: the last three decide, as before
     assert solver._amplitude_trend(np.array([0.05, 0.04, 0.03]))[1]
+
+
+def test_cycle_amplitude_is_the_median_drop_of_the_later_half():
+    t = np.linspace(0.0, 100.0, 20001)
+    amp = np.where(t < 50.0, 0.05, 0.01)  # a transient, then a cycle of drop 0.02
+    sigma = 0.9 + amp * np.sin(2.0 * np.pi * t / 2.0)
+    records = pd.DataFrame({"t": t, "sigma": sigma, "sigma_min": sigma, "sigma_max": sigma, "sigma_mean": sigma})
+    common = dict(model=micro.Model(k0=0.1), V=1.0, eps=0.016, sigma_max=math.nan, sigma_min=math.nan,
+                  sigma_mean=math.nan, period=math.nan, converged=False, message="", t_end=100.0, n_cycles=0,
+                  wall_time=0.0, records=records)
+    cycle = solver.Stationary(regime="stick-slip", **common)
+    assert solver._cycle_amplitude(cycle) == pytest.approx(0.02, rel=1e-3)
+    # below the hysteresis (2 k0 eps = 0.0032) there are no cycles, and steady is 0
+    small = records.assign(sigma=0.9 + 0.001 * np.sin(np.pi * t))
+    assert solver._cycle_amplitude(solver.Stationary(regime="stick-slip", **dict(common, records=small))) == 0.0
+    assert solver._cycle_amplitude(solver.Stationary(regime="steady", **common)) == 0.0
+
+
+def test_the_check_at_half_the_bin_brackets_the_n_block_critical_velocity():
+    # k0 = 0.3 at the phase diagram's coarse bin eps = 0.025.  The N-block (N = 1e5,
+    # stepped down from steady sliding at V = 2, as benchmarks/micro_hopf_amplitude.py)
+    # keeps a cycle of 0.042 at V = 0.15 and only its finite-N noise (0.005, which falls
+    # like N^-1/2) at V = 0.25.  The bisection without the check put V^c at 0.12: the
+    # physical cycle at V = 0.125 (drop 1.99 eps, no global shock) was taken for the grid's.
+    model = micro.Model(k0=0.3)
+    eps = 0.025
+    base = simulate_nblock(model, 2.0, 100_000, t_max=30.0, initial="frozen")
+    amp = {}
+    for V in (0.15, 0.25):
+        ts = simulate_nblock(model, V, 100_000, t_max=60.0, initial=base.final_state, record_every=0.02).timeseries
+        late = ts[ts.t > 10.0]
+        windows = [late[(late.t >= a) & (late.t < a + 10.0)] for a in (10.0, 20.0, 30.0, 40.0, 50.0)]
+        amp[V] = float(np.median([w.sigma_max.max() - w.sigma_min.min() for w in windows]))
+    assert amp[0.15] > 0.03 and amp[0.25] < 0.01
+    crit = micro.critical_velocity(model, V_guess=0.2, factor=1.5, rel_tol=0.1, numerics=micro.Numerics(eps=eps))
+    assert crit.status == "converged"
+    assert 0.15 < crit.V_low and crit.V_high < 0.25
+    evals = pd.DataFrame(crit.evaluations)
+    checked = evals.amplitude_fine.notna()
+    assert checked.any()
+    for e in evals.itertuples():
+        if e.regime != "stick-slip":
+            assert e.label == e.regime and math.isnan(e.amplitude_fine)
+        elif e.amplitude >= solver.GRID_CYCLE_EPS * eps:
+            assert e.label == "stick-slip" and math.isnan(e.amplitude_fine)
+        else:  # checked at eps / 2: a physical cycle keeps its amplitude
+            keeps = e.amplitude_fine >= solver.REFINE_RATIO * e.amplitude
+            assert e.label == ("stick-slip" if keeps else "steady")
