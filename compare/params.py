@@ -64,6 +64,9 @@ class Settings:
     critical_k0, critical_rel_tol : k0 whose micro Vc is bisected (at ``eps``) for the
         table of critical velocities, and the bisection tolerance; the other k0 get the
         bracket of their diagram points.
+    vc_refine : every micro bisection (critical, Hopf, phase) checks oscillations smaller
+        than 2 eps at eps / 2 (``micro.critical_velocity``'s ``refine``): several times
+        the cost near Vc, without it Vc carries the grid's error (docs/compare.md).
     rs_points : velocities per k0 of the RS bifurcation curves.
     classical_b : b of the classical RS law, Eq. (7) (raised to 1.5 W(V) if smaller, so
         that a = b - W(V) > 0).
@@ -88,6 +91,7 @@ class Settings:
     bootstrap: int = 400
     critical_k0: tuple[float, ...] = (0.1,)
     critical_rel_tol: float = 0.1
+    vc_refine: bool = True
     rs_points: int = 50
     hopf_k0: float = 0.1
     hopf_distances: tuple[float, ...] = (0.15, 0.3, 0.5, 0.7)
@@ -132,6 +136,8 @@ class Settings:
                                          reverse=True)))
         set_("critical_rel_tol", in_range("critical_rel_tol", self.critical_rel_tol, 0.0, 1.0, low_open=True,
                                           high_open=True))
+        if not isinstance(self.vc_refine, bool):
+            raise ValueError(f"vc_refine must be True or False, got {self.vc_refine!r}")
         set_("rs_points", positive_int("rs_points", self.rs_points, low=5))
         set_("classical_b", positive("classical_b", self.classical_b))
         set_("hopf_k0", positive("hopf_k0", self.hopf_k0))
@@ -172,7 +178,7 @@ class Settings:
                    hopf_k0=0.3, hopf_distances=(0.2, 0.4, 0.6, 0.8), hopf_rel_tol=0.3,
                    phase_sets=((0.5, 0.5),), phase_k0=(0.3,), phase_rel_tol=0.3, phase_eps=0.025,
                    phase_reference_V=(0.1, 0.3, 1.0, 3.0), shs_k0=0.3, shs_V=3.0, hold_times=(0.3, 1.0, 3.0, 10.0),
-                   preset="quick")
+                   vc_refine=False, preset="quick")
         return replace(base, **changes) if changes else base
 
     @classmethod

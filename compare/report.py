@@ -113,7 +113,7 @@ class _Study:
             guess = float(min(max(guess, 1e-4), 1e3))
             tasks.append(CriticalTask(s.model(k0, k1, k2), V_min=1e-4, V_max=1e3, rel_tol=rel_tol,
                                       numerics=s.numerics(eps), convergence=s.convergence(),
-                                      V_guess=guess, factor=2.0))
+                                      V_guess=guess, factor=2.0, refine=s.vc_refine))
         recs = self.runner.run(tasks, desc=desc)
         rows = []
         for rec in recs:

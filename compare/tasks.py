@@ -143,8 +143,9 @@ class StationaryTask(_TaskBase):
 
 @dataclass(frozen=True)
 class CriticalTask(_TaskBase):
-    """``micro.critical_velocity(model, V_min=..., V_max=..., rel_tol=..., V_guess=..., factor=...)``
-    (bracketing outward from ``V_guess`` by ``factor``, then bisection)."""
+    """``micro.critical_velocity(model, V_min=..., V_max=..., rel_tol=..., V_guess=..., factor=..., refine=...)``
+    (bracketing outward from ``V_guess`` by ``factor``, then bisection; with ``refine``
+    oscillations smaller than 2 eps are checked at eps / 2)."""
 
     model: micro.Model
     V_min: float
@@ -154,6 +155,7 @@ class CriticalTask(_TaskBase):
     convergence: micro.Convergence
     V_guess: float = 1.0
     factor: float = 4.0
+    refine: bool = True
     kind = "critical"
 
     def __post_init__(self) -> None:
@@ -170,13 +172,14 @@ class CriticalTask(_TaskBase):
     def describe(self) -> dict[str, Any]:
         return {"kind": self.kind, "model": model_description(self.model), "V_min": self.V_min,
                 "V_max": self.V_max, "rel_tol": self.rel_tol,
-                "V_guess": self.V_guess, "factor": self.factor,
+                "V_guess": self.V_guess, "factor": self.factor, "refine": bool(self.refine),
                 "numerics": _numerics_description(self.numerics, self.model),
                 "convergence": _convergence_description(self.convergence)}
 
     def run(self) -> dict[str, Any]:
         crit = micro.critical_velocity(self.model, V_min=self.V_min, V_max=self.V_max, rel_tol=self.rel_tol,
-                                       V_guess=self.V_guess, factor=self.factor, numerics=self.numerics, convergence=self.convergence)
+                                       V_guess=self.V_guess, factor=self.factor, numerics=self.numerics,
+                                       convergence=self.convergence, refine=self.refine)
         out = crit.to_dict()
         out["evaluations"] = crit.evaluations
         return out
