@@ -53,6 +53,21 @@ def test_cli_sweep_and_run_write_the_documented_columns(tmp_path):
     assert run.w.iloc[-1] == pytest.approx(10.0)
 
 
+def test_cli_critical_writes_the_documented_columns(tmp_path):
+    # a coarse bin, a loose tolerance, V_min = 0.02 and no check at eps/2 keep this to seconds
+    out = tmp_path / "vc.csv"
+    res = _cli("critical", "--k0", "0.3,1.0", "--eps", "0.025", "--rel-tol", "0.3", "--V-min", "0.02", "--no-refine",
+               "--out", str(out), cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    table = pd.read_csv(out)
+    for col in "k0,k1,k2,zbar,Vc".split(","):
+        assert col in table.columns
+    stick, never = table.iloc[0], table.iloc[1]
+    assert stick.status == "converged" and stick.V_low < stick.Vc < stick.V_high <= 1.3 * stick.V_low
+    assert never.status == "no stick-slip" and never.Vc == 0.0  # k0 >= k2
+    assert "--no-refine" in _cli("critical", "--help", cwd=tmp_path).stdout
+
+
 def test_cli_help_and_bad_input(tmp_path):
     res = _cli("sweep", "--help", cwd=tmp_path)
     assert res.returncode == 0 and "--eps" in res.stdout and "--dist" in res.stdout
