@@ -578,16 +578,21 @@ REFINE_RATIO = 0.7
 
 
 def _cycle_amplitude(res: Stationary) -> float:
-    """Median stress drop of the cycles in the later half of a run with records (0 for a
-    steady run, or with fewer than two cycles there)."""
-    if res.regime == "steady" or res.records is None or len(res.records) < 3:
+    """Median stress drop of the cycles in the later half of a run with records; the
+    run's own ``sigma_max - sigma_min`` if fewer than two cycles lie there (a slow cycle
+    converged early); 0 for a steady run."""
+    if res.regime == "steady":
         return 0.0
+    own = float(res.sigma_max - res.sigma_min)
+    own = own if math.isfinite(own) else 0.0
+    if res.records is None or len(res.records) < 3:
+        return own
     r = res.records
     rec = Records(*(r[c].to_numpy() for c in ("t", "sigma", "sigma_min", "sigma_max", "sigma_mean")))
     rec = rec.since(0.5 * (rec.t[0] + rec.t[-1]))
     cycles = find_cycles(rec, 2.0 * _jitter(res.model, res.eps))
     if len(cycles) < 2:
-        return 0.0
+        return own
     return float(np.median(cycles.sigma_max - cycles.sigma_min))
 
 
@@ -623,9 +628,10 @@ def critical_velocity(
     stress drop is below ``GRID_CYCLE_EPS * eps`` is run again at eps / 2, stepped down
     from steady sliding at eps / 2 in the same way, and counts as stick-slip only if it
     keeps at least ``REFINE_RATIO`` (0.7) of its amplitude: a physical cycle converges
-    in eps, the grid's shrinks with it.  Each such check costs about ten runs at eps.
-    Measured against the N-block's V^c (0.70-0.75 at k0 = 0.1, 0.19-0.21 at k0 = 0.3):
-    0.729 and 0.186 at eps = 0.016 (docs/micro_numerics.md, section 5).  Without
+    in eps, the grid's shrinks with it.  A check costs 5-10 runs at eps, and near V^c
+    most runs need one.  Measured against the N-block's V^c (0.70-0.75 at k0 = 0.1,
+    0.19-0.21 at k0 = 0.3): 0.73 and 0.186 at eps = 0.016 (docs/micro_numerics.md,
+    section 5).  Without
     ``refine`` a cycle counts as stick-slip only if it has global shocks or a stress drop
     of at least ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS * eps)``, which is
     cheaper but leaves V^c the discretisation error of the cycle near threshold
@@ -634,8 +640,8 @@ def critical_velocity(
 
     ``evaluations`` records each run, with the ``label`` the bisection used, the
     velocity it ``started_from``, its median cycle ``amplitude`` and, where checked,
-    ``amplitude_fine`` at eps / 2 and that run's ``wall_time_fine`` (NaN otherwise;
-    ``amplitude`` is NaN without ``refine``).
+    ``amplitude_fine`` at eps / 2 and the ``wall_time_fine`` of the runs at eps / 2 it
+    took (NaN otherwise; ``amplitude`` is NaN without ``refine``).
     """
     V_min = _check_velocity(V_min, "V_min")
     V_max = _check_velocity(V_max, "V_max")
@@ -673,7 +679,7 @@ def critical_velocity(
             t_max = max(100.0 * tau_u if math.isfinite(tau_u) else 0.0, 30.0 * tau_load)
             conv = Convergence(rtol=conv.rtol, atol=conv.atol, n=conv.n, t_max=t_max)
         res, started_from = run(V, conv, numerics, slowest_steady)
-        amplitude, fine_amplitude, fine = math.nan, math.nan, None
+        amplitude, fine_amplitude, fine_wall = math.nan, math.nan, math.nan
         if not refine:
             label = _bisection_label(res)
         else:
@@ -681,10 +687,13 @@ def critical_velocity(
             amplitude = _cycle_amplitude(res)
             if res.regime == "stick-slip" and amplitude < GRID_CYCLE_EPS * eps:
                 # too small to tell from the grid's own oscillation: does it survive at eps / 2?
+                fine_wall = 0.0
                 if fine_steady["grid"] is None and math.isfinite(slowest_steady["V"]):
                     base, _ = run(slowest_steady["V"], conv, fine_numerics, fine_steady)
                     fine_steady.update(V=slowest_steady["V"], grid=base.grid)
+                    fine_wall += base.wall_time
                 fine, _ = run(V, conv, fine_numerics, fine_steady)
+                fine_wall += fine.wall_time
                 fine_amplitude = _cycle_amplitude(fine)
                 if fine_amplitude < REFINE_RATIO * amplitude:
                     label = "steady"
@@ -693,8 +702,7 @@ def critical_velocity(
         if label == "steady" and V < slowest_steady["V"]:
             slowest_steady.update(V=V, grid=res.grid)
         evaluations.append(dict(res.to_dict(), label=label, started_from=started_from, amplitude=amplitude,
-                                amplitude_fine=fine_amplitude,
-                                wall_time_fine=fine.wall_time if fine is not None else math.nan))
+                                amplitude_fine=fine_amplitude, wall_time_fine=fine_wall))
         log.info("bisection k0=%g V=%.6g -> %s (%s; amplitude %.3g, at eps/2 %.3g)", model.k0, V, label,
                  res.message, amplitude, fine_amplitude)
         return label

@@ -222,9 +222,11 @@ def test_cycle_amplitude_is_the_median_drop_of_the_later_half():
                   wall_time=0.0, records=records)
     cycle = solver.Stationary(regime="stick-slip", **common)
     assert solver._cycle_amplitude(cycle) == pytest.approx(0.02, rel=1e-3)
-    # below the hysteresis (2 k0 eps = 0.0032) there are no cycles, and steady is 0
+    # below the hysteresis (2 k0 eps = 0.0032) there are no cycles: the run's own drop
     small = records.assign(sigma=0.9 + 0.001 * np.sin(np.pi * t))
     assert solver._cycle_amplitude(solver.Stationary(regime="stick-slip", **dict(common, records=small))) == 0.0
+    own = dict(common, records=small, sigma_max=0.95, sigma_min=0.9)
+    assert solver._cycle_amplitude(solver.Stationary(regime="stick-slip", **own)) == pytest.approx(0.05)
     assert solver._cycle_amplitude(solver.Stationary(regime="steady", **common)) == 0.0
 
 
