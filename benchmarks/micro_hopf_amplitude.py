@@ -7,11 +7,14 @@ amplitude at every bin and N; an oscillation of the grid shrinks with eps (near 
 reaches ~2 eps), and the N-block's finite-N noise falls like N^-1/2.  This is the independent check of the
 bisection's V^c (`micro.critical_velocity`).
 
-Writes benchmarks/results/micro_hopf_amplitude.csv (rows merge by k0, resolution and V; a bin eps < 1 never equals an N).
+Writes benchmarks/results/micro_hopf_amplitude.csv (rows merge by k0, k1, k2, resolution and V; a bin
+eps < 1 never equals an N).  A run lasts at least 30 block cycles (30 zbar / V); one made longer
+has its windows lengthened by the same factor.
 
     python benchmarks/micro_hopf_amplitude.py                              # k0 = 0.1
     python benchmarks/micro_hopf_amplitude.py --solver fp --eps 0.004 --V 0.8,0.9
     python benchmarks/micro_hopf_amplitude.py --solver nblock --N 1e6 --t-max 60
+    python benchmarks/micro_hopf_amplitude.py --k0 0.3 --k1 0.5 --k2 0.5 --solver nblock --V 0.02,0.04,0.06
 """
 from __future__ import annotations
 
@@ -40,17 +43,25 @@ def amplitude(t: np.ndarray, smax: np.ndarray, smin: np.ndarray, window: float, 
     return float(np.median(pp)), float(np.max(pp))
 
 
+def run_length(model: micro.Model, V: float, t_max: float, window: float) -> tuple[float, float]:
+    """At least 30 block cycles (30 zbar / V); a run made longer has its windows
+    lengthened by the same factor."""
+    T = max(t_max, 30.0 * model.zbar / V)
+    return T, window * T / t_max
+
+
 def fp_rows(model: micro.Model, eps: float, Vs: list[float], t_max: float, window: float) -> list[dict]:
     num = micro.Numerics(eps=eps)
     base = micro.stationary(model, V_START, numerics=num, keep_grid=True)
     rows = []
     for V in Vs:
         t = time.perf_counter()
-        r = micro.simulate(model, V, duration=t_max, numerics=num, initial=base.grid,
-                           record_dsigma=0.25 * model.k0 * eps, record_dt=window / 200.0).records
-        med, top = amplitude(r.t.to_numpy(), r.sigma_max.to_numpy(), r.sigma_min.to_numpy(), window, t_max)
+        T, W = run_length(model, V, t_max, window)
+        r = micro.simulate(model, V, duration=T, numerics=num, initial=base.grid,
+                           record_dsigma=0.25 * model.k0 * eps, record_dt=W / 200.0).records
+        med, top = amplitude(r.t.to_numpy(), r.sigma_max.to_numpy(), r.sigma_min.to_numpy(), W, T)
         rows.append(dict(solver="fp", resolution=eps, V=V, amplitude=med, amplitude_max=top,
-                         in_k0_eps=med / (model.k0 * eps), t_max=t_max, wall_s=time.perf_counter() - t))
+                         in_k0_eps=med / (model.k0 * eps), t_max=T, wall_s=time.perf_counter() - t))
         print(rows[-1], flush=True)
     return rows
 
@@ -60,10 +71,11 @@ def nblock_rows(model: micro.Model, N: int, Vs: list[float], t_max: float, windo
     rows = []
     for V in Vs:
         t = time.perf_counter()
-        r = simulate_nblock(model, V, N, t_max=t_max, initial=base.final_state, record_every=window / 500.0).timeseries
-        med, top = amplitude(r.t.to_numpy(), r.sigma_max.to_numpy(), r.sigma_min.to_numpy(), window, t_max)
+        T, W = run_length(model, V, t_max, window)
+        r = simulate_nblock(model, V, N, t_max=T, initial=base.final_state, record_every=W / 500.0).timeseries
+        med, top = amplitude(r.t.to_numpy(), r.sigma_max.to_numpy(), r.sigma_min.to_numpy(), W, T)
         rows.append(dict(solver="nblock", resolution=float(N), V=V, amplitude=med, amplitude_max=top,
-                         in_k0_eps=np.nan, t_max=t_max, wall_s=time.perf_counter() - t))
+                         in_k0_eps=np.nan, t_max=T, wall_s=time.perf_counter() - t))
         print(rows[-1], flush=True)
     return rows
 
@@ -71,6 +83,8 @@ def nblock_rows(model: micro.Model, N: int, Vs: list[float], t_max: float, windo
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--k0", type=float, default=0.1)
+    ap.add_argument("--k1", type=float, default=0.1)
+    ap.add_argument("--k2", type=float, default=0.9)
     ap.add_argument("--solver", choices=("fp", "nblock", "both"), default="both")
     ap.add_argument("--eps", type=str, default="0.016,0.008", help="comma-separated FP bins")
     ap.add_argument("--N", type=str, default="1e5", help="comma-separated N-block sizes")
@@ -78,7 +92,7 @@ def main() -> None:
     ap.add_argument("--t-max", type=float, default=120.0, help="simulated time per velocity")
     ap.add_argument("--window", type=float, default=10.0, help="amplitude window (time units)")
     args = ap.parse_args()
-    model = micro.Model(k0=args.k0)
+    model = micro.Model(k0=args.k0, k1=args.k1, k2=args.k2)
     Vs = [float(v) for v in args.V.split(",")]
     out = HERE / "results" / "micro_hopf_amplitude.csv"
     runs = []
@@ -91,10 +105,10 @@ def main() -> None:
             rows = fp_rows(model, res, Vs, args.t_max, args.window)
         else:
             rows = nblock_rows(model, int(res), Vs, args.t_max, args.window)
-        new = pd.DataFrame(rows).assign(k0=args.k0)
-        merged(out, new, ["k0", "resolution", "V"]).to_csv(out, index=False)
-    table = pd.read_csv(out).sort_values(["k0", "V", "solver", "resolution"])
-    print(table.pivot_table(index=["k0", "V"], columns=["solver", "resolution"], values="amplitude").to_string(
+        new = pd.DataFrame(rows).assign(k0=args.k0, k1=args.k1, k2=args.k2)
+        merged(out, new, ["k0", "k1", "k2", "resolution", "V"]).to_csv(out, index=False)
+    table = pd.read_csv(out).sort_values(["k1", "k0", "V", "solver", "resolution"])
+    print(table.pivot_table(index=["k1", "k2", "k0", "V"], columns=["solver", "resolution"], values="amplitude").to_string(
         float_format=lambda x: f"{x:.4f}"))
 
 
