@@ -587,8 +587,7 @@ def _cycle_amplitude(res: Stationary) -> float:
     own = own if math.isfinite(own) else 0.0
     if res.records is None or len(res.records) < 3:
         return own
-    r = res.records
-    rec = Records(*(r[c].to_numpy() for c in ("t", "sigma", "sigma_min", "sigma_max", "sigma_mean")))
+    rec = Records.from_array(res.records[["t", "sigma", "sigma_min", "sigma_max", "sigma_mean"]].to_numpy())
     rec = rec.since(0.5 * (rec.t[0] + rec.t[-1]))
     cycles = find_cycles(rec, 2.0 * _jitter(res.model, res.eps))
     if len(cycles) < 2:
