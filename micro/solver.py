@@ -627,7 +627,7 @@ def critical_velocity(
     stress drop is below ``GRID_CYCLE_EPS * eps`` is run again at eps / 2, stepped down
     from steady sliding at eps / 2 in the same way, and counts as stick-slip only if it
     keeps at least ``REFINE_RATIO`` (0.7) of its amplitude: a physical cycle converges
-    in eps, the grid's shrinks with it.  A check costs 5-10 runs at eps, and near V^c
+    in eps, the grid's shrinks with it.  A check costs 7-12 runs at eps, and near V^c
     most runs need one.  Measured against the N-block's V^c (0.70-0.75 at k0 = 0.1,
     0.19-0.21 at k0 = 0.3): 0.73 and 0.186 at eps = 0.016 (docs/micro_numerics.md,
     section 5).  Without
