@@ -630,12 +630,11 @@ def critical_velocity(
     in eps, the grid's shrinks with it.  A check costs 7-12 runs at eps, and near V^c
     most runs need one.  Measured against the N-block's V^c (0.70-0.75 at k0 = 0.1,
     0.19-0.21 at k0 = 0.3): 0.73 and 0.186 at eps = 0.016 (docs/micro_numerics.md,
-    section 5).  Without
-    ``refine`` a cycle counts as stick-slip only if it has global shocks or a stress drop
-    of at least ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS * eps)``, which is
-    cheaper but leaves V^c the discretisation error of the cycle near threshold
-    (k0 = 0.1: 0.90 and 0.84 at eps = 0.016 and 0.008) and, at coarse bins, takes small
-    physical cycles for the grid's.
+    section 5).  Without ``refine`` a cycle counts as stick-slip only if it has global
+    shocks or a stress drop of at least ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS *
+    eps)``, which is cheaper but leaves V^c the discretisation error of the cycle near
+    threshold (k0 = 0.1: 0.90 and 0.84 at eps = 0.016 and 0.008) and, at coarse bins,
+    takes small physical cycles for the grid's.
 
     ``evaluations`` records each run, with the ``label`` the bisection used, the
     velocity it ``started_from``, its median cycle ``amplitude`` and, where checked,
