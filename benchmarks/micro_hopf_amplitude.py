@@ -1,7 +1,7 @@
 """Oscillation amplitude against V near V^c: Fokker-Planck at several bins against the N-block.
 
-Both solvers start from their steady state at V = 2 (above V^c) and are stepped down to
-each V.  The amplitude is the median, over windows of `--window` time units after the
+Both solvers start from their steady state at `--V-start` (default the larger of 2 and
+1.5 times the largest V, above V^c) and are stepped down to each V.  The amplitude is the median, over windows of `--window` time units after the
 first, of the peak-to-peak stress in the window.  A physical cycle has the same
 amplitude at every bin and N; an oscillation of the grid shrinks with eps (near V^c it
 reaches ~2 eps), and the N-block's finite-N noise falls like N^-1/2.  This is the independent check of the
@@ -15,6 +15,7 @@ has its windows lengthened by the same factor.
     python benchmarks/micro_hopf_amplitude.py --solver fp --eps 0.004 --V 0.8,0.9
     python benchmarks/micro_hopf_amplitude.py --solver nblock --N 1e6 --t-max 60
     python benchmarks/micro_hopf_amplitude.py --k0 0.3 --k1 0.5 --k2 0.5 --solver nblock --V 0.02,0.04,0.06
+    python benchmarks/micro_hopf_amplitude.py --k0 0.01 --solver nblock --V 7,7.5,8,8.5,9.5 --t-max 80
 """
 from __future__ import annotations
 
@@ -30,7 +31,6 @@ from _budget import merged
 from micro.nblock import simulate_nblock
 
 HERE = Path(__file__).resolve().parent
-V_START = 2.0
 
 
 def amplitude(t: np.ndarray, smax: np.ndarray, smin: np.ndarray, window: float, t_max: float) -> tuple[float, float]:
@@ -50,9 +50,9 @@ def run_length(model: micro.Model, V: float, t_max: float, window: float) -> tup
     return T, window * T / t_max
 
 
-def fp_rows(model: micro.Model, eps: float, Vs: list[float], t_max: float, window: float) -> list[dict]:
+def fp_rows(model: micro.Model, eps: float, Vs: list[float], t_max: float, window: float, V_start: float) -> list[dict]:
     num = micro.Numerics(eps=eps)
-    base = micro.stationary(model, V_START, numerics=num, keep_grid=True)
+    base = micro.stationary(model, V_start, numerics=num, keep_grid=True)
     rows = []
     for V in Vs:
         t = time.perf_counter()
@@ -66,8 +66,8 @@ def fp_rows(model: micro.Model, eps: float, Vs: list[float], t_max: float, windo
     return rows
 
 
-def nblock_rows(model: micro.Model, N: int, Vs: list[float], t_max: float, window: float) -> list[dict]:
-    base = simulate_nblock(model, V_START, N, t_max=30.0, initial="frozen")
+def nblock_rows(model: micro.Model, N: int, Vs: list[float], t_max: float, window: float, V_start: float) -> list[dict]:
+    base = simulate_nblock(model, V_start, N, t_max=30.0, initial="frozen")
     rows = []
     for V in Vs:
         t = time.perf_counter()
@@ -91,9 +91,12 @@ def main() -> None:
     ap.add_argument("--V", type=str, default="0.6,0.7,0.8,0.9,1.0,1.2", help="comma-separated velocities")
     ap.add_argument("--t-max", type=float, default=120.0, help="simulated time per velocity")
     ap.add_argument("--window", type=float, default=10.0, help="amplitude window (time units)")
+    ap.add_argument("--V-start", type=float, default=None,
+                    help="steady start, above V^c (default max(2, 1.5 max V))")
     args = ap.parse_args()
     model = micro.Model(k0=args.k0, k1=args.k1, k2=args.k2)
     Vs = [float(v) for v in args.V.split(",")]
+    V_start = args.V_start if args.V_start is not None else max(2.0, 1.5 * max(Vs))
     out = HERE / "results" / "micro_hopf_amplitude.csv"
     runs = []
     if args.solver in ("fp", "both"):
@@ -102,9 +105,9 @@ def main() -> None:
         runs += [("nblock", float(n)) for n in args.N.split(",")]
     for solver, res in runs:
         if solver == "fp":
-            rows = fp_rows(model, res, Vs, args.t_max, args.window)
+            rows = fp_rows(model, res, Vs, args.t_max, args.window, V_start)
         else:
-            rows = nblock_rows(model, int(res), Vs, args.t_max, args.window)
+            rows = nblock_rows(model, int(res), Vs, args.t_max, args.window, V_start)
         new = pd.DataFrame(rows).assign(k0=args.k0, k1=args.k1, k2=args.k2)
         merged(out, new, ["k0", "k1", "k2", "resolution", "V"]).to_csv(out, index=False)
     table = pd.read_csv(out).sort_values(["k1", "k0", "V", "solver", "resolution"])
