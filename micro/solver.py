@@ -349,6 +349,7 @@ def stationary(
     initial="auto",
     keep_records: bool = False,
     keep_grid: bool = False,
+    warn: bool = True,
 ) -> Stationary:
     """Drive at constant ``V`` until the attractor's stress has converged, and stop there.
 
@@ -357,6 +358,9 @@ def stationary(
     :class:`Convergence`); a stick-slip cycle when ``n`` consecutive cycles agree.  If
     neither happens by ``t_max`` the result says so (``converged=False``) and gives
     the last estimates, with the regime judged from the trend of the oscillation.
+    That, and a converged cycle small enough to be the grid's, is also logged as a
+    warning unless ``warn`` is False (for callers that report it themselves, such as
+    :func:`critical_velocity`); ``converged`` and ``message`` say it either way.
     """
     V = _check_velocity(V)
     numerics = numerics or Numerics()
@@ -403,7 +407,8 @@ def stationary(
             per_cycle = _shocks_per_cycle(_shock_times(shock_rows), last)
             if _grid_sized(drop, per_cycle, _grid_limit(model, settings.eps)):
                 message += _grid_note(drop, jitter)
-                log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
+                if warn:
+                    log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
             out = dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
                        sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
                        sigma_stderr=float(last.sigma_mean.std(ddof=1) / math.sqrt(n)), shocks_per_cycle=per_cycle)
@@ -451,7 +456,7 @@ def stationary(
         result.shocks = pd.DataFrame(shocks, columns=["t", "sigma_before", "sigma_after", "shift"])
     if keep_grid:
         result.grid = grid
-    if not converged:
+    if not converged and warn:
         log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
     return result
 
@@ -664,7 +669,7 @@ def critical_velocity(
         """A run at V, from the chain's steady state if it is faster than V."""
         started_from = chain["V"] if V < chain["V"] and chain["grid"] is not None else math.nan
         res = stationary(model, V, numerics=num, convergence=conv, keep_grid=True, keep_records=refine,
-                         initial=chain["grid"] if math.isfinite(started_from) else "auto")
+                         initial=chain["grid"] if math.isfinite(started_from) else "auto", warn=False)
         return res, started_from
 
     def regime(V: float) -> str:
@@ -713,8 +718,8 @@ def critical_velocity(
     while True:
         if steady:
             if V <= V_min:
-                return Critical(model, 0.0, 0.0, V_min, "no stick-slip",
-                                f"steady already at V_min = {V_min:g}", evaluations)
+                return _reported(Critical(model, 0.0, 0.0, V_min, "no stick-slip",
+                                          f"steady already at V_min = {V_min:g}", evaluations))
             V = max(V / factor, V_min)
             if regime(V) != "steady":
                 lo = V
@@ -722,8 +727,8 @@ def critical_velocity(
             hi = V
         else:
             if V >= V_max:
-                return Critical(model, math.inf, V_max, math.inf, "above range",
-                                f"not steady at V_max = {V_max:g}", evaluations)
+                return _reported(Critical(model, math.inf, V_max, math.inf, "above range",
+                                          f"not steady at V_max = {V_max:g}", evaluations))
             V = min(V * factor, V_max)
             if regime(V) == "steady":
                 hi = V
@@ -735,8 +740,21 @@ def critical_velocity(
             hi = mid
         else:
             lo = mid
-    return Critical(model, math.sqrt(lo * hi), lo, hi, "converged",
-                    f"bracket [{lo:.6g}, {hi:.6g}] within rel_tol {rel_tol:g}", evaluations)
+    return _reported(Critical(model, math.sqrt(lo * hi), lo, hi, "converged",
+                              f"bracket [{lo:.6g}, {hi:.6g}] within rel_tol {rel_tol:g}", evaluations))
+
+
+def _reported(crit: Critical) -> Critical:
+    """``crit``, after one warning for the bisection's runs that missed their stopping
+    test (near V^c most do: the damping vanishes there).  The runs themselves do not
+    warn; each is logged at INFO and recorded in ``crit.evaluations``."""
+    missed = [e for e in crit.evaluations if not e["converged"]]
+    if missed:
+        log.warning("micro.critical_velocity(k0=%g): %s (%s); %d of %d runs did not converge by their t_max "
+                    "and were labelled from the trend of their oscillation (V = %s; see Critical.evaluations)",
+                    crit.model.k0, crit.status, crit.message, len(missed), len(crit.evaluations),
+                    ", ".join(f"{e['V']:.4g}" for e in missed))
+    return crit
 
 
 # ------------------------------------------------------------------------------ sweep
