@@ -750,10 +750,10 @@ def _reported(crit: Critical) -> Critical:
     warn; each is logged at INFO and recorded in ``crit.evaluations``."""
     missed = [e for e in crit.evaluations if not e["converged"]]
     if missed:
-        log.warning("micro.critical_velocity(k0=%g): %s (%s); %d of %d runs did not converge by their t_max "
-                    "and were labelled from the trend of their oscillation (V = %s; see Critical.evaluations)",
-                    crit.model.k0, crit.status, crit.message, len(missed), len(crit.evaluations),
-                    ", ".join(f"{e['V']:.4g}" for e in missed))
+        log.warning("micro.critical_velocity(k0=%g, k1=%g, k2=%g): %s (%s); %d of %d runs did not converge by "
+                    "their t_max and were labelled from the trend of their oscillation (V = %s; see "
+                    "Critical.evaluations)", crit.model.k0, crit.model.k1, crit.model.k2, crit.status, crit.message,
+                    len(missed), len(crit.evaluations), ", ".join(f"{e['V']:.4g}" for e in missed))
     return crit
 
 
