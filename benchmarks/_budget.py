@@ -20,7 +20,7 @@ VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51, 0.001: 116.5, 0.0001: 1167.0}
 
 def merged(path: Path, new: pd.DataFrame, keys: list[str], replace: pd.DataFrame | None = None) -> pd.DataFrame:
     """``new`` and the rows of the CSV at ``path`` (if any) whose ``keys`` match no row of
-    ``replace`` (default ``new``; compared with np.isclose).  The file is read now, so
+    ``replace`` (default ``new``; numbers compared with np.isclose, other keys exactly).  The file is read now, so
     points another run wrote meanwhile are kept."""
     if not path.exists():
         return new.reset_index(drop=True)
@@ -28,7 +28,10 @@ def merged(path: Path, new: pd.DataFrame, keys: list[str], replace: pd.DataFrame
     replace = new if replace is None else replace
     same = np.ones((len(old), len(replace)), dtype=bool)
     for key in keys:
-        same &= np.isclose(old[key].to_numpy(float)[:, None], replace[key].to_numpy(float))
+        if pd.api.types.is_numeric_dtype(replace[key]):
+            same &= np.isclose(old[key].to_numpy(float)[:, None], replace[key].to_numpy(float))
+        else:
+            same &= old[key].to_numpy(str)[:, None] == replace[key].to_numpy(str)
     return pd.concat([old[~same.any(axis=1)], new], ignore_index=True)
 
 
