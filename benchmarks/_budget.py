@@ -20,8 +20,8 @@ VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51, 0.001: 116.5, 0.0001: 1167.0}
 
 def merged(path: Path, new: pd.DataFrame, keys: list[str], replace: pd.DataFrame | None = None) -> pd.DataFrame:
     """``new`` and the rows of the CSV at ``path`` (if any) whose ``keys`` match no row of
-    ``replace`` (default ``new``; numbers compared with np.isclose, other keys exactly).  The file is read now, so
-    points another run wrote meanwhile are kept."""
+    ``replace`` (default ``new``; numbers compared with np.isclose, other keys exactly).
+    The file is read now, so points another run wrote meanwhile are kept."""
     if not path.exists():
         return new.reset_index(drop=True)
     old = pd.read_csv(path)

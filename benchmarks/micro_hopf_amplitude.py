@@ -1,8 +1,9 @@
 """Oscillation amplitude against V near V^c: Fokker-Planck at several bins against the N-block.
 
 Both solvers start from their steady state at `--V-start` (default the larger of 2 and
-1.5 times the largest V, above V^c) and are stepped down to each V.  The amplitude is the median, over windows of `--window` time units after the
-first, of the peak-to-peak stress in the window.  A physical cycle has the same
+1.5 times the largest V, above V^c) and are stepped down to each V.  The amplitude is the
+median, over windows of `--window` time units after the first, of the peak-to-peak stress
+in the window.  A physical cycle has the same
 amplitude at every bin and N; an oscillation of the grid shrinks with eps (near V^c it
 reaches ~2 eps), and the N-block's finite-N noise falls like N^-1/2.  This is the independent check of the
 bisection's V^c (`micro.critical_velocity`).

@@ -641,6 +641,9 @@ def critical_velocity(
     threshold (k0 = 0.1: 0.90 and 0.84 at eps = 0.016 and 0.008) and, at coarse bins,
     takes small physical cycles for the grid's.
 
+    Runs that miss their stopping test (near V^c most do) are reported in one warning
+    when the bisection ends, not each by its own; every run is logged at INFO.
+
     ``evaluations`` records each run, with the ``label`` the bisection used, the
     velocity it ``started_from``, its median cycle ``amplitude`` and, where checked,
     ``amplitude_fine`` at eps / 2 and the ``wall_time_fine`` of the runs at eps / 2 it
