@@ -52,7 +52,7 @@ def run_point(k0: float, V: float, eps: float, budget: float, t_max: float | Non
     if t_max is None:
         t_max = capped_t_max(model, V, eps, budget)
     t = time.perf_counter()
-    r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(t_max=t_max))
+    r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(t_max=t_max), method="fp")
     return dict(k0=k0, V=V, eps=eps, regime=r.regime, converged=r.converged, sigma=r.sigma_mean,
                 sigma_stderr=r.sigma_stderr, t_end=r.t_end, t_max=t_max, wall_s=time.perf_counter() - t,
                 mass_error=r.mass_error, min_mass=r.min_mass, message=r.message)
@@ -96,7 +96,7 @@ def main() -> None:
     else:
         k0s = [float(x) for x in args.k0.split(",")]
         bins = [float(x) for x in args.eps.split(",")]
-        micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024))  # compile
+        micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
         rows = []
         for k0 in k0s:
             V = 1.5 * VC_RS[k0]

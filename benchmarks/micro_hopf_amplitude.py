@@ -53,7 +53,7 @@ def run_length(model: micro.Model, V: float, t_max: float, window: float) -> tup
 
 def fp_rows(model: micro.Model, eps: float, Vs: list[float], t_max: float, window: float, V_start: float) -> list[dict]:
     num = micro.Numerics(eps=eps)
-    base = micro.stationary(model, V_start, numerics=num, keep_grid=True)
+    base = micro.stationary(model, V_start, numerics=num, keep_grid=True, method="fp")
     rows = []
     for V in Vs:
         t = time.perf_counter()

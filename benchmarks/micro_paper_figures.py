@@ -93,7 +93,7 @@ def fig4(eps: float, budget: float, k0s, ratios=RATIOS, t_max: float | None = No
             try:
                 cap = t_max if t_max is not None else capped_t_max(model, V, eps, budget)
                 res = micro.stationary(model, V, numerics=micro.Numerics(eps=eps),
-                                       convergence=micro.Convergence(t_max=cap))
+                                       convergence=micro.Convergence(t_max=cap), method="fp")
                 row = res.to_dict()
             except micro.GridTooLarge as exc:  # the solver's clear refusal: kept, drawn nowhere
                 row = dict(k0=k0, V=V, regime="refused", converged=False, sigma_max=math.nan,
@@ -174,7 +174,7 @@ def main() -> None:
     figs = {int(f) for f in args.figs.split(",")}
     DATA.mkdir(parents=True, exist_ok=True)
     FIGS.mkdir(parents=True, exist_ok=True)
-    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024))  # compile
+    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
     if 3 in figs:
         fig3(args.eps, 10 * args.budget)
     if 4 in figs or 6 in figs:

@@ -84,13 +84,13 @@ def fp_cycles(model: micro.Model, eps: float) -> dict:
 def fp_stationary(model: micro.Model, eps: float, n: int = 3) -> dict:
     """micro.stationary with its own stopping rule (the last ``n`` cycles agree within
     rtol = 1e-3 of the drop plus k0 eps)."""
-    r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(rtol=1e-3, n=n))
+    r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(rtol=1e-3, n=n), method="fp")
     return dict(regime=r.regime, converged=r.converged, sigma_max_drift=np.nan, sigma_max=r.sigma_max,
                 sigma_min=r.sigma_min, period=r.period, sigma_max_stderr=np.nan, sigma_min_stderr=np.nan)
 
 
 def fp_rows(model: micro.Model, eps_list: list[float]) -> list[dict]:
-    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024))  # compile
+    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
     rows = []
     for eps in eps_list:
         for solver, measure in (("fp", fp_cycles), ("fp_stationary", fp_stationary),

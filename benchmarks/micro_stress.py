@@ -40,7 +40,7 @@ def check(model: micro.Model, V: float, eps: float, budget: float, t_max: float 
     t = time.perf_counter()
     try:
         t_max = min(capped_t_max(model, V, eps, budget), T_CAP) if t_max is None else t_max
-        r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(t_max=t_max))
+        r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(t_max=t_max), method="fp")
     except micro.GridTooLarge as exc:  # a clear refusal, not a failure
         return dict(k0=model.k0, V=V, eps=eps, t_max=t_max, wall_s=time.perf_counter() - t, regime="refused",
                     converged=False, sigma_max=math.nan, sigma_min=math.nan, sigma_mean=math.nan,
@@ -68,7 +68,7 @@ def main() -> None:
     ap.add_argument("--budget", type=float, default=20.0, help="wall-time budget per run, seconds (default 20)")
     ap.add_argument("--k0", default=",".join(map(str, K0)), help="comma-separated k0 values of the (k0, V) grid")
     args = ap.parse_args()
-    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024))  # compile
+    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
     rows = []
 
     def report(row):
@@ -109,7 +109,7 @@ def main() -> None:
     # bins outside the range are refused with a message naming eps and the range
     for eps in (micro.Model(k0=0.1).kappa * 0.1 / 2000.0, 0.5):
         try:
-            micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=eps))
+            micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=eps), method="fp")
             print(f"FAIL eps={eps:g} was accepted")
             rows.append(dict(k0=0.1, V=2.0, eps=eps, problems="out-of-range eps accepted"))
         except ValueError as exc:

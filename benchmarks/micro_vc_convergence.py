@@ -37,7 +37,7 @@ def main() -> None:
     ap.add_argument("--refine", choices=("yes", "no", "both"), default="yes",
                     help="check oscillations smaller than 2 eps at eps / 2 (critical_velocity's refine)")
     args = ap.parse_args()
-    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024))  # compile
+    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
     out = HERE / "results" / "micro_vc_convergence.csv"
     refines = {"yes": (True,), "no": (False,), "both": (False, True)}[args.refine]
     rows = []
@@ -46,7 +46,7 @@ def main() -> None:
         for eps, refine in ((float(e), r) for e in args.eps.split(",") for r in refines):
             t = time.perf_counter()
             crit = micro.critical_velocity(model, V_guess=VC_RS[k0], factor=1.5, numerics=micro.Numerics(eps=eps),
-                                           refine=refine)
+                                           refine=refine, method="fp")
             evals = pd.DataFrame(crit.evaluations)
             unconverged = int((~evals.converged.astype(bool)).sum())
             grid_cycles = int(((evals.regime == "stick-slip") & (evals.label == "steady")).sum())

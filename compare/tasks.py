@@ -179,7 +179,7 @@ class CriticalTask(_TaskBase):
     def run(self) -> dict[str, Any]:
         crit = micro.critical_velocity(self.model, V_min=self.V_min, V_max=self.V_max, rel_tol=self.rel_tol,
                                        V_guess=self.V_guess, factor=self.factor, numerics=self.numerics,
-                                       convergence=self.convergence, refine=self.refine)
+                                       convergence=self.convergence, refine=self.refine, method="fp")
         out = crit.to_dict()
         out["evaluations"] = crit.evaluations
         return out

@@ -1,14 +1,18 @@
-r"""micro — the mean-field viscoelastic depinning model of Landes, Rosso & Jagla (2015),
-solved as a Fokker-Planck (master) equation for the joint density P(delta_F, delta_R)
-at finite driving velocity (their Appendix B), with an independent N-block check.
+r"""micro — the mean-field viscoelastic depinning model of Landes, Rosso & Jagla (2015).
+
+Steady sliding and its stability are solved directly, as the jump-to-jump renewal chain
+of one block (:mod:`micro.renewal`); transients, stick-slip cycles and slide-hold-slide
+by a Fokker-Planck (master) equation for the joint density P(delta_F, delta_R) at finite
+driving velocity (their Appendix B), with an independent N-block check.
 
 The obvious entry points::
 
     import micro
     model = micro.Model(k0=0.01)                       # Fig. 4 parameters: k1=.1, k2=.9, zbar=.1
     run = micro.simulate(model, 5.0, duration=50.0)    # stress time series, w = V t
+    steady = micro.steady_sliding(model, [1.0, 5.0])   # steady branch: sigma, branching ratio, stability
+    vc = micro.critical_velocity(model)                # V^c where the branching ratio reaches 1
     state = micro.stationary(model, 5.0)               # steady stress, or sigma_max / sigma_min
-    vc = micro.critical_velocity(model)                # bisection on the regime
     table = micro.sweep(model, [1.0, 5.0, 20.0])       # one row per V
     peaks = micro.slide_hold_slide(model, 1000.0, [0.1, 1.0, 10.0])
 """
@@ -18,6 +22,7 @@ from .grid import GridTooLarge
 from .analytic import sigma_deterministic_steady, sigma_fast_limit, sigma_slow_limit
 from .params import Deterministic, Exponential, JumpDistribution, Model, Tabulated
 from .protocols import Drive
+from .renewal import SteadySliding, characteristic_function, steady_sliding, unstable_mode_count, vc_small_k0
 from .solver import (
     Convergence,
     Critical,
@@ -44,6 +49,11 @@ __all__ = [
     "Run",
     "Stationary",
     "Critical",
+    "SteadySliding",
+    "steady_sliding",
+    "characteristic_function",
+    "unstable_mode_count",
+    "vc_small_k0",
     "GridTooLarge",
     "simulate",
     "stationary",

@@ -1,4 +1,4 @@
-"""Command line: ``python -m micro sweep|critical|run``.
+"""Command line: ``python -m micro steady|sweep|critical|run``.
 
 Defaults are the paper's Fig. 4 parameters (k1 = 0.1, k2 = 0.9, zbar = 0.1, exponential
 pinning distances with cutoff 10, eta_u = 1, f_th = 1).  The default bin eps is
@@ -16,6 +16,7 @@ import pandas as pd
 
 from .params import Deterministic, Exponential, Model
 from .protocols import Drive
+from .renewal import steady_sliding
 from .solver import Convergence, Numerics, critical_velocity, default_eps, simulate, stationary
 
 log = logging.getLogger("micro")
@@ -82,15 +83,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
     sub = p.add_subparsers(dest="command", required=True)
 
+    st = sub.add_parser("steady", help="steady sliding from the renewal chain (either branch): one CSV row per V, "
+                                       "milliseconds each")
+    _model_options(st)
+    st.add_argument("--V", required=True, help="drive velocities, comma-separated, each in [1e-6, 1e7]")
+    st.add_argument("--no-growth-rate", dest="growth_rate", action="store_false",
+                    help="skip the growth rate of the unstable mode (about 0.1 s per unstable V)")
+    st.add_argument("--out", required=True,
+                    help="output CSV: k0,k1,k2,zbar,V,sigma,branching_ratio,stable,growth_rate,sigma_error,converged")
+
     s = sub.add_parser("sweep", help="stationary state for each drive velocity: one CSV row per V")
     _model_options(s)
     s.add_argument("--V", required=True, help="drive velocities, comma-separated, each > 0")
     s.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,V,regime,sigma_max,sigma_min,sigma_mean,...")
 
-    c = sub.add_parser("critical", help="critical velocity Vc by bisection on the regime (the paper's Appendix B)")
+    c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
+                                        "(--method fp: bisection on Fokker-Planck runs, the paper's Appendix B)")
     _model_options(c, k0_list=True)
+    c.add_argument("--method", choices=("renewal", "fp"), default="renewal",
+                   help="renewal (default): the direct solution, ~1e-10 relative in < 1 s; fp: bisection on "
+                        "Fokker-Planck runs (minutes, uncertain by the bin)")
     c.add_argument("--V-min", type=float, default=1e-4, help="lower end of the bracket (default 1e-4)")
-    c.add_argument("--V-max", type=float, default=1e3, help="upper end of the bracket (default 1e3)")
+    c.add_argument("--V-max", type=float, default=None,
+                   help="upper end of the bracket (default 1e7 with --method renewal, 1e3 with fp)")
     c.add_argument("--rel-tol", type=float, default=1e-2, help="stop when V_high/V_low - 1 <= this (default 1e-2)")
     c.add_argument("--no-refine", dest="refine", action="store_false",
                    help="decide oscillations smaller than 2 eps by their size and global shocks instead of "
@@ -123,6 +138,15 @@ def main(argv: list[str] | None = None) -> int:
 
 def _run(args) -> int:
     start = time.perf_counter()
+    if args.command == "steady":
+        velocities = _floats(args.V, "V")
+        model = _model(args, args.k0)
+        res = steady_sliding(model, velocities, growth_rate=args.growth_rate)
+        frame = res.to_frame()
+        frame.to_csv(args.out, index=False)
+        print(f"wrote {len(frame)} rows to {args.out} in {time.perf_counter() - start:.2f} s"
+              f"{'' if frame.converged.all() else ' (' + res.message + ')'}", file=sys.stderr)
+        return 0 if frame.converged.all() else 3
     if args.command == "sweep":
         velocities = _floats(args.V, "V")
         model = _model(args, args.k0)
@@ -143,7 +167,8 @@ def _run(args) -> int:
             model = _model(args, k0)
             numerics, convergence = _numerics(args)
             crit = critical_velocity(model, V_min=args.V_min, V_max=args.V_max, rel_tol=args.rel_tol,
-                                     numerics=numerics, convergence=convergence, refine=args.refine)
+                                     numerics=numerics, convergence=convergence, refine=args.refine,
+                                     method=args.method)
             rows.append(crit.to_dict())
             print(f"k0={k0:g}: Vc={crit.Vc:.6g} ({crit.status})", file=sys.stderr)
         pd.DataFrame(rows).to_csv(args.out, index=False)

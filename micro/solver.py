@@ -23,6 +23,7 @@ from .analytic import sigma_fast_limit
 from .grid import Grid, GridSettings
 from .params import Model
 from .protocols import Drive
+from .renewal import critical_velocity_renewal, steady_sliding
 
 __all__ = [
     "Numerics",
@@ -340,6 +341,22 @@ def _drive_position(drive: Drive, t: float) -> float:
 
 
 # ------------------------------------------------------------------------------ stationary
+def _direct_steady(model: Model, V: float) -> Stationary | None:
+    """The steady state from the renewal chain if steady sliding is stable at V, else None."""
+    start = time.perf_counter()
+    res = steady_sliding(model, V, growth_rate=False)
+    if not bool(res.stable):
+        return None
+    sigma = float(res.sigma)
+    return Stationary(
+        model=model, V=V, eps=math.nan, regime="steady", sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma,
+        period=math.nan, converged=bool(res.converged),
+        message=(f"steady sliding is stable (branching ratio {float(res.branching_ratio):.6g} < 1): "
+                 f"stress from the renewal chain ({int(res.n_nodes)} nodes, error {float(res.sigma_error):.1e})"),
+        t_end=0.0, n_cycles=0, wall_time=time.perf_counter() - start, sigma_stderr=float(res.sigma_error),
+        shocks_per_cycle=0.0, mass_error=0.0, min_mass=0.0)
+
+
 def stationary(
     model: Model,
     V: float,
@@ -350,8 +367,19 @@ def stationary(
     keep_records: bool = False,
     keep_grid: bool = False,
     warn: bool = True,
+    method: str = "auto",
 ) -> Stationary:
-    """Drive at constant ``V`` until the attractor's stress has converged, and stop there.
+    """The attractor at constant drive velocity ``V``: a steady stress or a stick-slip cycle.
+
+    ``method="auto"`` (the default) asks the renewal chain first
+    (:func:`micro.steady_sliding`): where steady sliding is stable its stress is exact
+    (to ~1e-11, in milliseconds) and no time-stepping is done; elsewhere, and whenever
+    the Fokker-Planck state is wanted (``keep_grid``, ``keep_records`` or an ``initial``
+    grid), the Fokker-Planck equation is time-stepped as with ``method="fp"``, which
+    always time-steps.
+
+    Time-stepping drives at constant ``V`` until the attractor's stress has converged,
+    and stops there.
 
     A steady state is reached when the stress stays flat (within the jitter of the
     discretisation) and the means of ``n`` consecutive spans agree (see
@@ -363,9 +391,16 @@ def stationary(
     :func:`critical_velocity`); ``converged`` and ``message`` say it either way.
     """
     V = _check_velocity(V)
+    if method not in ("auto", "fp"):
+        raise ValueError(f"method must be 'auto' or 'fp', got {method!r}")
     numerics = numerics or Numerics()
     convergence = convergence or Convergence()
     settings = numerics.settings(model)
+    wants_fp_state = keep_grid or keep_records or not (isinstance(initial, str) and initial == "auto")
+    if method == "auto" and not wants_fp_state:
+        direct = _direct_steady(model, V)
+        if direct is not None:
+            return direct
     grid = _initial_grid(model, settings, V, initial)
     start = time.perf_counter()
 
@@ -604,15 +639,28 @@ def critical_velocity(
     model: Model,
     *,
     V_min: float = 1e-4,
-    V_max: float = 1e3,
+    V_max: float | None = None,
     V_guess: float = 1.0,
     factor: float = 8.0,
     rel_tol: float = 1e-2,
     numerics: Numerics | None = None,
     convergence: Convergence | None = None,
     refine: bool = True,
+    method: str = "renewal",
 ) -> Critical:
-    """Critical velocity by bisection on the regime (the paper's Appendix B).
+    """Critical velocity V^c: where steady sliding loses stability.
+
+    ``method="renewal"`` (the default) solves it directly: V^c is the root of
+    ``b(V) = 1``, the branching ratio of steady sliding from the renewal chain
+    (:func:`micro.steady_sliding`; derivation in docs/micro_renewal.md), to ~1e-10
+    relative in a fraction of a second.  ``V_min`` and ``V_max`` (default 1e7 here, 1e3
+    for the bisection) bound the search; the
+    other options belong to ``method="fp"``.  ``k0 >= k2``: Vc = 0 at once (steady
+    sliding is stable at every V).  ``V_low`` and ``V_high`` are ``Vc`` minus and plus
+    its error estimate.
+
+    ``method="fp"``: bisection on the regime of Fokker-Planck runs (the paper's
+    Appendix B), kept for cross-checks.
 
     The regime is evaluated at ``V_guess``, then at velocities ``factor`` times smaller
     or larger (within ``[V_min, V_max]``) until it changes; the bracket is then halved
@@ -649,8 +697,10 @@ def critical_velocity(
     ``amplitude_fine`` at eps / 2 and the ``wall_time_fine`` of the runs at eps / 2 it
     took (NaN otherwise; ``amplitude`` is NaN without ``refine``).
     """
+    if method not in ("renewal", "fp"):
+        raise ValueError(f"method must be 'renewal' or 'fp', got {method!r}")
     V_min = _check_velocity(V_min, "V_min")
-    V_max = _check_velocity(V_max, "V_max")
+    V_max = _check_velocity((1e7 if method == "renewal" else 1e3) if V_max is None else V_max, "V_max")
     if not V_max > V_min:
         raise ValueError(f"V_max must be > V_min, got V_min={V_min!r}, V_max={V_max!r}")
     V_guess = _check_velocity(V_guess, "V_guess")
@@ -658,6 +708,13 @@ def critical_velocity(
         raise ValueError(f"factor must be a finite number > 1, got {factor!r}")
     if not (math.isfinite(rel_tol) and 0.0 < rel_tol < 1.0):
         raise ValueError(f"rel_tol must be in (0, 1), got {rel_tol!r}")
+    if method == "renewal":
+        Vc, error, status, message, evaluations = critical_velocity_renewal(model, V_min=V_min, V_max=V_max)
+        low, high = (Vc - error, Vc + error) if math.isfinite(Vc) and Vc > 0.0 else (
+            (0.0, V_min) if Vc == 0.0 else (V_max, math.inf))
+        if status != "converged":
+            log.info("micro.critical_velocity(k0=%g, k1=%g, k2=%g): %s", model.k0, model.k1, model.k2, message)
+        return Critical(model, Vc, low, high, status, message, evaluations)
     evaluations: list[dict] = []
 
     convergence = convergence or Convergence()
@@ -768,16 +825,27 @@ def sweep(
     numerics: Numerics | None = None,
     convergence: Convergence | None = None,
     continuation: bool = True,
+    method: str = "auto",
 ) -> pd.DataFrame:
     """Stationary states for each velocity, one row each.
 
-    With ``continuation`` every point starts from the previous point's final density
-    (points are visited in the given order), which shortens transients.
+    With ``method="auto"`` a velocity where steady sliding is stable takes its row from
+    the renewal chain (no time-stepping); the others are Fokker-Planck runs
+    (``method="fp"``: all of them).  With ``continuation`` every Fokker-Planck run starts
+    from the previous run's final density (points are visited in the given order),
+    which shortens transients.
     """
+    if method not in ("auto", "fp"):
+        raise ValueError(f"method must be 'auto' or 'fp', got {method!r}")
+    velocities = [_check_velocity(V) for V in velocities]
     rows = []
     grid = None
     for V in velocities:
-        res = stationary(model, V, numerics=numerics, convergence=convergence,
+        direct = _direct_steady(model, V) if method == "auto" else None
+        if direct is not None:
+            rows.append(direct.to_dict())
+            continue
+        res = stationary(model, V, numerics=numerics, convergence=convergence, method="fp",
                          initial=grid if (continuation and grid is not None) else "auto", keep_grid=continuation)
         grid = res.grid
         res.grid = None
@@ -808,7 +876,7 @@ def slide_hold_slide(
     for h in holds:
         if not (math.isfinite(h) and h >= 0.0):
             raise ValueError(f"hold times must be finite numbers >= 0, got {h!r}")
-    base = stationary(model, V, numerics=numerics, convergence=convergence, keep_grid=True)
+    base = stationary(model, V, numerics=numerics, convergence=convergence, keep_grid=True, method="fp")
     if base.regime != "steady":
         raise ValueError(f"slide-hold-slide needs steady sliding at V = {V:g}; the attractor is {base.regime}")
     tau_u, tau_c, _ = _time_scales(model, V)

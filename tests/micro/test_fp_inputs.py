@@ -65,14 +65,14 @@ def test_numerics_and_protocols_reject_bad_parameters(make, match):
 def test_bin_outside_usable_range_is_rejected_with_the_range(eps):
     model = micro.Model(k0=0.1)  # kappa * zbar = 0.11: eps in [1.1e-4, 2.75e-2]
     with pytest.raises(ValueError, match=r"eps must be in \[kappa\*zbar/1000, kappa\*zbar/4\]"):
-        micro.stationary(model, 1.0, numerics=micro.Numerics(eps=eps))
+        micro.stationary(model, 1.0, numerics=micro.Numerics(eps=eps), method="fp")
 
 
 @pytest.mark.parametrize("V", [0.0, -1.0, math.inf, math.nan])
 def test_solvers_reject_bad_velocity(V):
     model = micro.Model(k0=0.1)
     with pytest.raises(ValueError, match=r"V must be a finite number > 0"):
-        micro.stationary(model, V)
+        micro.stationary(model, V, method="fp")
     with pytest.raises(ValueError, match=r"V must be a finite number > 0"):
         micro.slide_hold_slide(model, V, [1.0])
 
@@ -80,11 +80,11 @@ def test_solvers_reject_bad_velocity(V):
 def test_critical_velocity_rejects_bad_bracket():
     model = micro.Model(k0=0.1)
     with pytest.raises(ValueError, match=r"V_max must be > V_min"):
-        micro.critical_velocity(model, V_min=1.0, V_max=0.5)
+        micro.critical_velocity(model, V_min=1.0, V_max=0.5, method="fp")
     with pytest.raises(ValueError, match=r"rel_tol must be in \(0, 1\)"):
-        micro.critical_velocity(model, rel_tol=0.0)
+        micro.critical_velocity(model, rel_tol=0.0, method="fp")
     with pytest.raises(ValueError, match=r"factor must be"):
-        micro.critical_velocity(model, factor=1.0)
+        micro.critical_velocity(model, factor=1.0, method="fp")
 
 
 def test_hold_times_must_be_nonnegative():

@@ -70,7 +70,7 @@ def test_renewal_limit_without_dashpots(V):
     exact = micro.sigma_fast_limit(model)
     errors = []
     for eps in (0.02, 0.01):
-        res = micro.stationary(model, V, numerics=micro.Numerics(eps=eps))
+        res = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), method="fp")
         assert res.converged and res.regime == "steady", res.message
         assert res.mass_error < 1e-12 and res.min_mass >= -1e-15
         errors.append(abs(res.sigma_mean - exact))
@@ -80,7 +80,7 @@ def test_renewal_limit_without_dashpots(V):
 
 
 def test_results_report_their_density_checks():
-    res = micro.stationary(micro.Model(k0=0.3), 3.0, numerics=FAST)
+    res = micro.stationary(micro.Model(k0=0.3), 3.0, numerics=FAST, method="fp")
     row = res.to_dict()
     assert row["mass_error"] < 1e-12 and row["min_mass"] >= -1e-15
 
@@ -105,7 +105,7 @@ def test_a_slow_loading_phase_is_not_taken_for_steady_sliding():
     # by less than the steady tolerance; the run used to stop there as "steady"
     # (sigma = 0.952 at t = 529).
     model = micro.Model(k0=1e-4)
-    res = micro.stationary(model, 1.0, numerics=micro.Numerics(eps=0.025), convergence=micro.Convergence(t_max=600.0))
+    res = micro.stationary(model, 1.0, numerics=micro.Numerics(eps=0.025), convergence=micro.Convergence(t_max=600.0), method="fp")
     assert not (res.converged and res.regime == "steady")
 
 
@@ -115,7 +115,7 @@ def test_an_unconverged_stick_slip_transient_is_labelled_stick_slip():
     # (A heuristic: at eps = 0.016 the amplitudes of this run are not monotone and the
     # label stays "steady"; the result says it did not converge either way.)
     res = micro.stationary(micro.Model(k0=0.1), 0.01, numerics=micro.Numerics(eps=0.012),
-                           convergence=micro.Convergence(t_max=400.0))
+                           convergence=micro.Convergence(t_max=400.0), method="fp")
     assert not res.converged
     assert res.regime == "stick-slip"
     assert "towards a cycle" in res.message or "persists" in res.message
@@ -125,13 +125,13 @@ def test_a_cycle_of_grid_size_is_flagged():
     # k0 = 0.01, V = 1000 slides steadily (V^c ~ 10), but at the coarsest bin the grid
     # keeps a converged oscillation of stress drop 5.4 k0 eps (amplitude ~ eps^2,
     # docs/micro_results.md): the result must say it may be the grid's.
-    res = micro.stationary(micro.Model(k0=0.01), 1000.0, numerics=micro.Numerics(eps=0.025))
+    res = micro.stationary(micro.Model(k0=0.01), 1000.0, numerics=micro.Numerics(eps=0.025), method="fp")
     assert res.regime == "stick-slip" and res.converged
     assert "oscillation of the grid" in res.message
     # ... and the critical-velocity bisection does not count it as stick-slip
     assert solver._bisection_label(res) == "steady"
     # a real cycle (k0 = 0.1, V = 0.05: stress drop ~ 40 k0 eps) is not flagged
-    real = micro.stationary(micro.Model(k0=0.1), 0.05, numerics=micro.Numerics(eps=0.016))
+    real = micro.stationary(micro.Model(k0=0.1), 0.05, numerics=micro.Numerics(eps=0.016), method="fp")
     assert real.regime == "stick-slip" and real.converged
     assert "grid" not in real.message
     assert solver._bisection_label(real) == "stick-slip"
@@ -143,7 +143,7 @@ def test_a_small_cycle_with_global_shocks_is_not_taken_for_the_grid():
     # per cycle) whose stress drop, 0.072, is only 9.5 k0 eps.  Going by the drop alone
     # flagged it, and the bisection would have called it steady.
     model = micro.Model(k0=0.3)
-    res = micro.stationary(model, 0.00685, numerics=micro.Numerics(eps=0.025))
+    res = micro.stationary(model, 0.00685, numerics=micro.Numerics(eps=0.025), method="fp")
     assert res.regime == "stick-slip" and res.converged
     assert res.sigma_max - res.sigma_min < solver.MARGINAL_CYCLE * model.k0 * 0.025
     assert res.shocks_per_cycle >= 1.0
@@ -160,7 +160,7 @@ def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state(caplo
     eps = 0.024
     with caplog.at_level(logging.INFO, logger="micro"):
         crit = micro.critical_velocity(model, V_guess=1.0, factor=1.5, rel_tol=0.05,
-                                       numerics=micro.Numerics(eps=eps), refine=False)
+                                       numerics=micro.Numerics(eps=eps), refine=False, method="fp")
     # the runs that miss their stopping test (near V^c most do) are reported once, by
     # the bisection, not each by its own warning
     missed = [e["V"] for e in crit.evaluations if not e["converged"]]
@@ -256,7 +256,7 @@ def test_the_check_at_half_the_bin_brackets_the_n_block_critical_velocity():
         windows = [late[(late.t >= a) & (late.t < a + 10.0)] for a in (10.0, 20.0, 30.0, 40.0, 50.0)]
         amp[V] = float(np.median([w.sigma_max.max() - w.sigma_min.min() for w in windows]))
     assert amp[0.15] > 0.03 and amp[0.25] < 0.01
-    crit = micro.critical_velocity(model, V_guess=0.2, factor=1.5, rel_tol=0.1, numerics=micro.Numerics(eps=eps))
+    crit = micro.critical_velocity(model, V_guess=0.2, factor=1.5, rel_tol=0.1, numerics=micro.Numerics(eps=eps), method="fp")
     assert crit.status == "converged"
     assert 0.15 < crit.V_low and crit.V_high < 0.25
     evals = pd.DataFrame(crit.evaluations)

@@ -12,7 +12,7 @@ STIFF = micro.Model(k0=1.0)  # k0 > k2: steady sliding at every V
 
 
 def _steady(model, V, eps):
-    res = micro.stationary(model, V, numerics=micro.Numerics(eps=eps))
+    res = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), method="fp")
     assert res.converged and res.regime == "steady", res.message
     assert res.mass_error < 1e-12 and res.min_mass >= -1e-15
     return res.sigma_mean
@@ -33,7 +33,7 @@ def test_large_velocity_limit_with_its_first_correction():
 def test_mean_dashpot_stretch_stays_zero_in_steady_sliding():
     # <delta_R> = k2 <u> only relaxes (jumps keep u): a scheme that lets it drift by
     # O(eps^2) per jump is off by (jump rate) eps^2 / gamma, which grows with V
-    res = micro.stationary(STIFF, 200.0, numerics=micro.Numerics(eps=0.016), keep_grid=True)
+    res = micro.stationary(STIFF, 200.0, numerics=micro.Numerics(eps=0.016), keep_grid=True, method="fp")
     cells = res.grid.cells()
     mean_dr = float((cells["mass"] * cells["delta_R"]).sum())
     assert abs(mean_dr) < 1e-4

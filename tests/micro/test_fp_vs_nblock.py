@@ -21,13 +21,13 @@ MODEL = micro.Model(k0=0.1)  # the paper's Fig. 4 parameters
 
 
 def _fp_steady(V, eps):
-    res = micro.stationary(MODEL, V, numerics=micro.Numerics(eps=eps))
+    res = micro.stationary(MODEL, V, numerics=micro.Numerics(eps=eps), method="fp")
     assert res.converged and res.regime == "steady", res.message
     return res.sigma_mean
 
 
 def _fp_cycle(V, eps, rtol=1e-3):
-    res = micro.stationary(MODEL, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(rtol=rtol))
+    res = micro.stationary(MODEL, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(rtol=rtol), method="fp")
     assert res.converged and res.regime == "stick-slip", res.message
     return res
 

@@ -1,0 +1,534 @@
+r"""Steady sliding and its stability, solved directly: the jump-to-jump renewal chain.
+
+In steady sliding the mean position moves at the drive velocity V, so every block is an
+independent renewal process driven at V (the derivation is in ``docs/micro_renewal.md``).
+Between jumps a block's lag behind the mean grows at rate V and its k2-spring stretch
+``e`` relaxes towards ``V tau`` (``tau = eta_u / k2 = 1/gamma``); it jumps when its
+margin reaches 0, and a jump lowers both by z ~ g.  Just before a jump the margin is 0,
+so the block's state there is one number, the spring's deficit ``d = V tau - e``; in
+units of ``V tau``, ``x = d / (V tau)`` lives on [0, 1] and jump to jump it is a Markov
+chain (:func:`micro._renewal_kernels.waiting_time`).  Its stationary measure gives
+
+* the stress :math:`\sigma = f_{th} - \langle\delta\rangle` (the time-averaged margin,
+  a positive integrand: no cancellation at large V),
+* the mean waiting time, which must equal :math:`\bar z / V` (a check),
+* the density of blocks at the threshold, and with it the branching ratio of an
+  avalanche in steady sliding :math:`b = p_0 \bar z (k_1 + k_2) = (k_1 + k_2)\,
+  E_\pi[1/(k_0 + k_1 + k_2 x)]`.
+
+Linear stability: perturbing the mean slip velocity by :math:`\nu e^{\lambda t}` and
+closing the loop through :math:`\dot{\bar h} = \bar z \times` (jump rate) gives the
+characteristic equation :math:`G(\lambda) = 1`, with :math:`G(0) = k_1/(k_0 + k_1)` and
+:math:`G(+\infty) = b`.  Steady sliding loses stability where b crosses 1: a real root
+enters from :math:`\lambda = +\infty` (:func:`unstable_mode_count` checks that no other
+root is in the right half-plane).
+
+Discretisation: Chebyshev collocation of the chain's expectation operator in x, on a
+sinh map centred where the linearised chain puts the stationary measure (it can be
+narrow: width ~ sqrt(gamma zbar / V) at large V, sqrt(k0/k2) with k1 = 0), and composite
+Gauss-Legendre in z, graded towards z = 0.  The stationary weights are quadrature weights
+(they may be negative), not a density.  Deterministic jumps have no density: the chain is
+a 1-D map whose fixed point Newton's method finds (it reproduces Eq. (4)).
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from numpy.polynomial.legendre import leggauss
+from scipy.optimize import brentq
+
+from . import _renewal_kernels as RK
+from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
+
+__all__ = ["SteadySliding", "steady_sliding", "critical_velocity_renewal", "characteristic_function",
+           "unstable_mode_count", "vc_small_k0"]
+
+log = logging.getLogger(__name__)
+
+#: Gauss-Legendre nodes per panel of the z quadrature.
+Z_NODES = 16
+#: Smallest and largest collocation grids tried by the adaptive solve.
+N_START, N_MAX = 32, 384
+#: Velocity range in which the chain is documented and tested.
+V_RANGE = (1e-6, 1e7)
+
+
+def _check_model(model: Model) -> None:
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be a micro.Model, got {type(model).__name__}")
+
+
+def _check_velocities(V) -> np.ndarray:
+    try:
+        v = np.asarray(V, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"V must be a number or an array of numbers, got {V!r}") from None
+    bad = ~(np.isfinite(v) & (v >= V_RANGE[0]) & (v <= V_RANGE[1]))
+    if np.any(bad):
+        raise ValueError(f"V must be finite and in [{V_RANGE[0]:g}, {V_RANGE[1]:g}], got {v[bad].ravel()[0]!r}")
+    return v
+
+
+# ------------------------------------------------------------------------------ quadrature in z
+@dataclass(frozen=True)
+class _Quadrature:
+    z: np.ndarray  # pinning distances
+    weight: np.ndarray  # probabilities, summing to 1
+    deterministic: bool
+
+    @property
+    def zbar(self) -> float:
+        return float(self.weight @ self.z)
+
+
+def _panels(lo_scale: float, zbar: float, z_top: float) -> np.ndarray:
+    """Panel ends: doubling from ``lo_scale`` up to ``zbar`` (at small V the waiting time
+    changes on the drive's loading distance), panels of zbar up to 4 zbar, then doubling
+    up to ``z_top`` (the exponential tail: 16 Gauss nodes integrate e^-z over 16 e-folds
+    to round-off)."""
+    ends = [0.0]
+    b = lo_scale
+    while b < zbar:
+        ends.append(b)
+        b *= 2.0
+    ends += [zbar, 2.0 * zbar, 3.0 * zbar, 4.0 * zbar]
+    b = 8.0 * zbar
+    while b < z_top:
+        ends.append(b)
+        b *= 2.0
+    ends = np.array(ends)
+    return np.unique(np.concatenate([ends[ends < z_top], [z_top]]))
+
+
+def _quadrature(model: Model, V: float, nodes: int = Z_NODES) -> _Quadrature:
+    """Composite Gauss-Legendre for E_z over g, graded towards z = 0 on the scale
+    ``alpha V / gamma`` where the waiting time changes fastest at small V."""
+    jumps = model.jumps
+    if jumps.kind == KIND_DETERMINISTIC:
+        return _Quadrature(np.array([jumps.mean]), np.array([1.0]), True)
+    zbar = jumps.mean
+    alpha = (model.k0 + model.k1) / model.kappa
+    lo_scale = 0.25 * max(alpha * V / model.gamma, 1e-12 * zbar)
+    if jumps.kind == KIND_EXPONENTIAL:
+        z_top = min(jumps.cutoff, 40.0 * jumps.zbar)
+        pdf = lambda z: np.exp(-z / jumps.zbar)  # noqa: E731 - normalised below
+    else:
+        z_top = jumps.z_max
+        pdf = lambda z: np.asarray(jumps.pdf(z), dtype=float)  # noqa: E731
+    ends = _panels(lo_scale, zbar, z_top)
+    g, w = leggauss(nodes)
+    mid, half = 0.5 * (ends[1:] + ends[:-1]), 0.5 * np.diff(ends)
+    z = (mid[:, None] + half[:, None] * g[None, :]).ravel()
+    weight = (half[:, None] * w[None, :]).ravel() * pdf(z)
+    if not (np.all(np.isfinite(weight)) and np.all(weight >= 0.0) and weight.sum() > 0.0):
+        raise ValueError("the jump distribution's pdf must be finite and >= 0 with positive mass")
+    keep = weight > 0.0
+    return _Quadrature(z[keep], weight[keep] / weight.sum(), False)
+
+
+# ------------------------------------------------------------------------------ the chain on a grid
+@dataclass
+class _Grid:
+    """Chebyshev points in theta, mapped to the deficit x by ``x = c + w sinh(mu + nu theta)``."""
+
+    theta: np.ndarray
+    x: np.ndarray
+    bw: np.ndarray
+    c: float
+    w: float
+    mu: float
+    nu: float
+
+    @classmethod
+    def build(cls, n: int, center: float, width: float) -> "_Grid":
+        theta = -np.cos(np.pi * np.arange(n) / (n - 1))
+        bw = (-1.0) ** np.arange(n)
+        bw[0] *= 0.5
+        bw[-1] *= 0.5
+        if not (math.isfinite(width) and width < 0.2):
+            return cls(theta, 0.5 * (theta + 1.0), bw, 0.5, math.inf, 0.0, 1.0)
+        a0, a1 = math.asinh((0.0 - center) / width), math.asinh((1.0 - center) / width)
+        mu, nu = 0.5 * (a1 + a0), 0.5 * (a1 - a0)
+        x = np.clip(center + width * np.sinh(mu + nu * theta), 0.0, 1.0)
+        x[0], x[-1] = 0.0, 1.0
+        return cls(theta, x, bw, center, width, mu, nu)
+
+    def dtheta_dx(self, x: np.ndarray) -> np.ndarray:
+        if not math.isfinite(self.w):
+            return np.full_like(x, 2.0)
+        return 1.0 / (self.nu * np.sqrt(self.w**2 + (x - self.c) ** 2))
+
+    def differentiation_matrix(self) -> np.ndarray:
+        """d/dtheta on the Chebyshev points (Trefethen, Spectral Methods in MATLAB, cheb)."""
+        n = self.theta.size
+        c = np.ones(n)
+        c[0] = c[-1] = 2.0
+        c *= (-1.0) ** np.arange(n)
+        dX = self.theta[:, None] - self.theta[None, :]
+        Dm = np.outer(c, 1.0 / c) / (dX + np.eye(n))
+        return Dm - np.diag(Dm.sum(axis=1))
+
+
+@dataclass
+class _Chain:
+    """The renewal chain of one (model, V) on one grid, with its stationary weights."""
+
+    model: Model
+    V: float
+    quad: _Quadrature
+    grid: _Grid
+    alpha: float
+    beta: float
+    zeta: np.ndarray
+    Q: np.ndarray
+    Et: np.ndarray
+    EI: np.ndarray
+    weights: np.ndarray
+    t: np.ndarray | None = None
+    xp: np.ndarray | None = None
+    L: np.ndarray | None = None
+
+    @classmethod
+    def solve(cls, model: Model, V: float, quad: _Quadrature, grid: _Grid, store: bool = False) -> "_Chain":
+        alpha, beta = (model.k0 + model.k1) / model.kappa, model.k2 / model.kappa
+        zeta = model.gamma * quad.z / V
+        Q, Et, EI, t, xp, L = RK.assemble(grid.x, grid.theta, grid.bw, zeta, quad.weight, alpha, beta,
+                                          grid.c, grid.w, grid.mu, grid.nu, store)
+        n = grid.x.size
+        # stationary weights: w Q = 0 (Q = M - I), sum(w) = 1, as one nonsingular system
+        A = 1.0 / n - Q
+        weights = np.linalg.solve(A.T, np.full(n, 1.0 / n))
+        return cls(model, V, quad, grid, alpha, beta, zeta, Q, Et, EI, weights,
+                   t if store else None, xp if store else None, L if store else None)
+
+    @property
+    def zeta_bar(self) -> float:
+        return float(self.quad.weight @ self.zeta)
+
+    @property
+    def sigma(self) -> float:
+        m = self.model
+        mean_margin = m.kappa * (self.V / m.gamma) * float(self.weights @ self.EI) / self.zeta_bar
+        return m.f_th - mean_margin
+
+    @property
+    def branching_ratio(self) -> float:
+        m = self.model
+        return (m.k1 + m.k2) * float(self.weights @ (1.0 / (m.k0 + m.k1 + m.k2 * self.grid.x)))
+
+    @property
+    def wait_error(self) -> float:
+        """E_pi[T] V / zbar - 1, which the exact stationary measure makes 0."""
+        return float(self.weights @ self.Et) / self.zeta_bar - 1.0
+
+
+#: Below this ratio (k0 + k1) / k2 the grid clusters at x = 0 on the scale (k0 + k1) / k2.
+BOUNDARY_LAYER = 0.05
+
+
+def _map_width(model: Model) -> float:
+    """Width of the sinh map, clustered at x = 0: with a small k0 + k1, blocks that waited
+    long (a large z) arrive with x near 0, where the waiting time and the density at the
+    threshold vary on the scale (k0 + k1)/k2 (their singularity is at x = -(k0+k1)/k2).
+    Otherwise the affine map (inf): Chebyshev collocation of the expectation operator
+    acts as a moment method and needs no resolution of the (narrow) stationary measure."""
+    ratio = (model.k0 + model.k1) / model.k2
+    return ratio if ratio < BOUNDARY_LAYER else math.inf
+
+
+def _solve_adaptive(model: Model, V: float, tol: float, n_max: int = N_MAX, store: bool = False):
+    """Grow the grid by 3/2 until sigma and b move less than ``tol``; returns the finest
+    chain, the error estimates (the last change) and whether ``tol`` was met."""
+    quad = _quadrature(model, V)
+    width = _map_width(model)
+    prev = None
+    n = N_START
+    while True:
+        chain = _Chain.solve(model, V, quad, _Grid.build(n, 0.0, width), store=store)
+        if prev is not None:
+            err_s = abs(chain.sigma - prev.sigma)
+            err_b = abs(chain.branching_ratio - prev.branching_ratio)
+            if (err_s <= tol and err_b <= tol) or n >= n_max:
+                return chain, err_s, err_b, bool(err_s <= tol and err_b <= tol)
+        prev = chain
+        n = min(int(1.5 * n), n_max)
+
+
+# ------------------------------------------------------------------------------ deterministic jumps
+def _deterministic(model: Model, V: float) -> tuple[float, float, float, float]:
+    """Fixed point x* of the 1-D map x -> x'(x, zbar) by Newton: (x*, t*, sigma, b)."""
+    alpha, beta = (model.k0 + model.k1) / model.kappa, model.k2 / model.kappa
+    zbar = model.jumps.mean
+    zeta = model.gamma * zbar / V
+
+    def step(x):
+        D = x + zeta
+        t = RK.waiting_time(zeta, D, alpha, beta)
+        xp = D * math.exp(-t)
+        t_x = -beta * (-math.expm1(-t)) / (alpha + beta * xp)
+        return xp - x, math.exp(-t) * (1.0 - D * t_x) - 1.0, t
+
+    x = 1.0 / (1.0 + 0.5 * zeta)  # close to zeta / (e^zeta - 1), the exact fixed point
+    for _ in range(100):
+        F, dF, t = step(x)
+        x_new = min(max(x - F / dF, 0.0), 1.0)
+        if abs(x_new - x) <= 1e-16 * max(x, 1e-300):
+            x = x_new
+            break
+        x = x_new
+    D = x + zeta
+    t = RK.waiting_time(zeta, D, alpha, beta)
+    integral = t * (zeta - 0.5 * alpha * t - beta * D * t * RK.phi2(t))
+    sigma = model.f_th - model.kappa * (V / model.gamma) * integral / zeta
+    b = (model.k1 + model.k2) / (model.k0 + model.k1 + model.k2 * x)
+    return x, t, sigma, b
+
+
+# ------------------------------------------------------------------------------ linear stability
+def _response_terms(chain_alpha, chain_beta, rho1, t, xp, D, lam):
+    """e^{-lam t} times the shift of the next jump time (dT) and of the arrival deficit
+    (dx) per unit relative perturbation of the slip velocity nu e^{lam t}, for blocks that
+    jumped at time 0 (chain units)."""
+    A = np.exp(-lam * t)
+    em = -np.expm1(-t)
+    one_minus_A_over_lam = -np.expm1(-lam * t) / lam
+    k = chain_beta / (lam + 1.0)
+    A_delta1 = -(rho1 - k) * one_minus_A_over_lam - k * em * A
+    A_dT = A_delta1 / (chain_alpha + chain_beta * xp)
+    A_dx = -(xp * A_dT + (-np.expm1(-(lam + 1.0) * t)) / (lam + 1.0))
+    return A, A_dT, A_dx
+
+
+def characteristic_function(model: Model, V: float, lam, *, tol: float = 1e-10) -> np.ndarray:
+    r"""The open-loop gain :math:`G(\lambda)` of steady sliding at drive velocity V.
+
+    A perturbation :math:`\nu e^{\lambda t}` of the mean slip velocity changes the jump
+    rate by :math:`G(\lambda)\,\nu e^{\lambda t}/\bar z`; the closed loop has a mode
+    :math:`e^{\lambda t}` where :math:`G(\lambda) = 1`.  ``lam`` is in units of 1/time
+    (real or complex, ``Re lam > -gamma``, not 0).  Limits: :math:`G(0^+) = k_1/(k_0+k_1)`,
+    :math:`G(+\infty) = b`, the branching ratio.
+    """
+    _check_model(model)
+    V = float(_check_velocities(V))
+    lam = np.asarray(lam, dtype=complex) / model.gamma
+    rho1 = (model.k1 + model.k2) / model.kappa
+    alpha, beta = (model.k0 + model.k1) / model.kappa, model.k2 / model.kappa
+    out = np.empty(lam.shape, dtype=complex)
+    if model.jumps.kind == KIND_DETERMINISTIC:
+        x, t, _, _ = _deterministic(model, V)
+        zeta = model.gamma * model.jumps.mean / V
+        D = x + zeta
+        t_x = -beta * (-math.expm1(-t)) / (alpha + beta * x)
+        x_x = math.exp(-t) * (1.0 - D * t_x)
+        for k, l in np.ndenumerate(lam):
+            A, A_dT, A_dx = _response_terms(alpha, beta, rho1, t, x, D, l)
+            h = 1.0 / (1.0 - A)
+            h1 = -l * t_x * A * h / (1.0 - A * x_x)
+            out[k] = -l * A_dT * h + A_dx * h1
+        return out
+    chain, _, _, _ = _solve_adaptive(model, V, tol, store=True)
+    grid, n = chain.grid, chain.grid.x.size
+    D = chain.grid.x[:, None] + chain.zeta[None, :]
+    Dtheta = grid.differentiation_matrix()
+    dthdx = grid.dtheta_dx(chain.xp)
+    wz = chain.quad.weight
+    for k, l in np.ndenumerate(lam):
+        A, A_dT, A_dx = _response_terms(alpha, beta, rho1, chain.t, chain.xp, D, l)
+        M = np.einsum("iq,iqj->ij", A * wz[None, :], chain.L)
+        h = np.linalg.solve(np.eye(n) - M, np.ones(n, dtype=complex))
+        H = chain.L @ h
+        H1 = (chain.L @ (Dtheta @ h)) * dthdx
+        out[k] = chain.weights @ np.sum(wz[None, :] * (-l * A_dT * H + A_dx * H1), axis=1)
+    return out
+
+
+def _growth_rate(model: Model, V: float, b: float, tol: float) -> float:
+    """The largest real root lam > 0 of G(lam) = 1 (in 1/time), NaN if b <= 1."""
+    if not b > 1.0:
+        return math.nan
+    f = lambda ll: float(characteristic_function(model, V, math.exp(ll), tol=tol).real[()]) - 1.0  # noqa: E731
+    zeta_bar = model.gamma * model.zbar / V
+    hi = math.log(model.gamma * 1e3 / zeta_bar / max(b - 1.0, 1e-6))
+    f_hi = f(hi)
+    while f_hi <= 0.0 and hi < 700.0:
+        hi += 4.0
+        f_hi = f(hi)
+    lo = hi
+    while True:
+        lo -= 2.0
+        f_lo = f(lo)
+        if f_lo <= 0.0:
+            break
+        if lo < math.log(model.gamma) - 60.0:
+            return math.nan
+        hi, f_hi = lo, f_lo
+    return math.exp(brentq(f, lo, hi, xtol=1e-12))
+
+
+def unstable_mode_count(model: Model, V: float, *, omega_max: float | None = None, n_omega: int = 4000,
+                        tol: float = 1e-10) -> int:
+    r"""The number of roots of :math:`G(\lambda) = 1` with :math:`\operatorname{Re}\lambda > 0`,
+    by the argument principle along the imaginary axis (G is analytic in the right
+    half-plane and tends to b on its large half-circle).  A check of the claim that b
+    alone decides stability; it costs ``n_omega`` evaluations of G."""
+    zeta_bar = model.gamma * model.zbar / V
+    if omega_max is None:
+        omega_max = 200.0 * model.gamma / zeta_bar
+    omega = np.concatenate([[1e-9 * model.gamma], np.geomspace(1e-6 * model.gamma, omega_max, n_omega)])
+    G = characteristic_function(model, V, 1j * omega, tol=tol) - 1.0
+    phase = np.unwrap(np.angle(G))
+    turns = (phase[-1] - phase[0]) / math.pi
+    tail = abs(G[-1] - (G[-1].real))  # the end of the axis must have settled near b - 1
+    if not (abs(turns - round(turns)) < 0.05 and tail < 0.5 * abs(G[-1].real)):
+        log.warning("unstable_mode_count(V=%g): the phase has not settled (%.3f turns, G(i omega_max)-1 = %s)",
+                    V, turns, G[-1])
+    return int(round(-turns))
+
+
+# ------------------------------------------------------------------------------ public results
+@dataclass
+class SteadySliding:
+    """Steady sliding at each drive velocity, from the renewal chain.
+
+    Arrays have the shape of the ``V`` given.  ``sigma`` is the stationary stress,
+    ``branching_ratio`` the mean number of blocks a jump pushes over the threshold,
+    ``stable`` whether steady sliding is linearly stable (b < 1), ``growth_rate`` the rate
+    of the unstable mode (1/time; NaN where stable or not asked for), ``sigma_error`` and
+    ``branching_error`` the change from the previous grid, ``wait_error`` the relative
+    error of the mean waiting time against zbar / V, ``n_nodes`` the grid used.
+    """
+
+    model: Model
+    V: np.ndarray
+    sigma: np.ndarray
+    branching_ratio: np.ndarray
+    stable: np.ndarray
+    growth_rate: np.ndarray
+    sigma_error: np.ndarray
+    branching_error: np.ndarray
+    wait_error: np.ndarray
+    n_nodes: np.ndarray
+    converged: np.ndarray
+    message: str = field(default="")
+
+    def to_frame(self) -> pd.DataFrame:
+        m = self.model
+        n = np.size(self.V)
+        return pd.DataFrame({
+            "k0": np.full(n, m.k0), "k1": np.full(n, m.k1), "k2": np.full(n, m.k2), "zbar": np.full(n, m.zbar),
+            "V": np.ravel(self.V), "sigma": np.ravel(self.sigma), "branching_ratio": np.ravel(self.branching_ratio),
+            "stable": np.ravel(self.stable), "growth_rate": np.ravel(self.growth_rate),
+            "sigma_error": np.ravel(self.sigma_error), "converged": np.ravel(self.converged),
+        })
+
+
+def _no_dashpot(model: Model) -> bool:
+    return model.k2 == 0.0
+
+
+def steady_sliding(model: Model, V, *, tol: float = 1e-11, growth_rate: bool = True,
+                   warn: bool = True) -> SteadySliding:
+    """Steady sliding at drive velocity ``V`` (a number or an array), on either branch.
+
+    The stationary measure of the jump-to-jump chain is solved on grids of 32, 48, 72, ...
+    nodes until sigma and the branching ratio change by less than ``tol`` (up to 384
+    nodes; ``converged`` says whether ``tol`` was met).  Cost: a few ms per V after
+    compilation; with ``growth_rate`` (the default) each unstable V also costs a root
+    search on G (about 0.1 s).  A grid that misses ``tol`` is logged as a warning unless
+    ``warn`` is False; ``converged`` and ``message`` say it either way.
+    """
+    _check_model(model)
+    v = _check_velocities(V)
+    if not (math.isfinite(tol) and tol > 0.0):
+        raise ValueError(f"tol must be a finite number > 0, got {tol!r}")
+    flat = v.ravel()
+    out = {k: np.full(flat.size, math.nan) for k in ("sigma", "b", "lam", "err_s", "err_b", "wait", "n")}
+    conv = np.ones(flat.size, dtype=bool)
+    for k, Vk in enumerate(flat):
+        if _no_dashpot(model):
+            # no relaxation: every margin renews with increments (k0 + k1) z at any V
+            out["sigma"][k] = model.f_th - (model.k0 + model.k1) * model.jumps.mean_residual
+            out["b"][k] = model.k1 / (model.k0 + model.k1)
+            out["err_s"][k] = out["err_b"][k] = out["wait"][k] = 0.0
+            out["n"][k] = 0
+        elif model.jumps.kind == KIND_DETERMINISTIC:
+            _, t, out["sigma"][k], out["b"][k] = _deterministic(model, float(Vk))
+            out["err_s"][k] = out["err_b"][k] = 0.0
+            out["wait"][k] = t / (model.gamma * model.jumps.mean / Vk) - 1.0
+            out["n"][k] = 1
+        else:
+            chain, err_s, err_b, ok = _solve_adaptive(model, float(Vk), tol)
+            out["sigma"][k], out["b"][k] = chain.sigma, chain.branching_ratio
+            out["err_s"][k], out["err_b"][k], out["wait"][k] = err_s, err_b, chain.wait_error
+            out["n"][k] = chain.grid.x.size
+            conv[k] = ok
+        if growth_rate and out["b"][k] > 1.0:
+            out["lam"][k] = _growth_rate(model, float(Vk), out["b"][k], max(tol, 1e-10))
+    shape = v.shape
+    stable = out["b"] < 1.0
+    message = "converged" if conv.all() else (
+        f"the grid did not reach tol = {tol:g} at V = "
+        + ", ".join(f"{x:g}" for x in flat[~conv]) + f" ({N_MAX} nodes); see sigma_error")
+    if not conv.all() and warn:
+        log.warning("micro.steady_sliding(k0=%g): %s", model.k0, message)
+    r = lambda a: a.reshape(shape)  # noqa: E731
+    return SteadySliding(model, v, r(out["sigma"]), r(out["b"]), r(stable), r(out["lam"]), r(out["err_s"]),
+                         r(out["err_b"]), r(out["wait"]), r(out["n"].astype(int)), r(conv), message)
+
+
+def vc_small_k0(model: Model) -> float:
+    r"""The small-k0 asymptote of the critical velocity,
+    :math:`V^c \simeq k_2 \gamma \langle z^2\rangle / (2 \bar z k_0)`: at large V the
+    stationary spring stretch at a jump averages the mean residual
+    :math:`\langle z^2\rangle/(2\bar z)`, and b = 1 where ``k2 E[1 - x] = k0``."""
+    _check_model(model)
+    return model.k2 * model.gamma * model.jumps.mean_residual / model.k0
+
+
+def critical_velocity_renewal(model: Model, *, V_min: float = 1e-4, V_max: float = 1e5, rtol: float = 1e-10,
+                              tol: float = 1e-11):
+    """V^c as the root of ``b(V) = 1``, the velocity where the branching ratio of steady
+    sliding crosses 1 (Brent's method on log V).  ``k0 >= k2`` (or ``k2 = 0``): steady
+    sliding is stable at every V (b < 1 already at V -> 0), Vc = 0 at once.
+    Returns ``(Vc, error, status, message, evaluations)``."""
+    _check_model(model)
+    evaluations: list[dict] = []
+    if model.k2 == 0.0 or model.k0 >= model.k2:
+        return 0.0, 0.0, "no stick-slip", (
+            f"k0 = {model.k0:g} >= k2 = {model.k2:g}: the branching ratio of steady sliding is below 1 at every V "
+            f"(its V -> 0 limit is (k1 + k2)/(k0 + k1)), no stick-slip"), evaluations
+
+    def f(log_v: float) -> float:
+        res = steady_sliding(model, math.exp(log_v), tol=tol, growth_rate=False, warn=False)
+        evaluations.append({"V": math.exp(log_v), "branching_ratio": float(res.branching_ratio),
+                            "error": float(res.branching_error)})
+        return float(res.branching_ratio) - 1.0
+
+    guess = min(max(vc_small_k0(model), V_min), V_max)
+    lo = hi = math.log(guess)
+    f_lo = f_hi = f(lo)
+    lmin, lmax = math.log(V_min), math.log(V_max)
+    while f_lo <= 0.0:  # still stable: go slower
+        if lo <= lmin:
+            return 0.0, 0.0, "no stick-slip", f"steady sliding stable already at V_min = {V_min:g}", evaluations
+        hi, f_hi = lo, f_lo
+        lo = max(lo - 1.5, lmin)
+        f_lo = f(lo)
+    while f_hi > 0.0:  # still unstable: go faster
+        if hi >= lmax:
+            return math.inf, math.inf, "above range", f"steady sliding unstable still at V_max = {V_max:g}", evaluations
+        lo, f_lo = hi, f_hi
+        hi = min(hi + 1.5, lmax)
+        f_hi = f(hi)
+    root = brentq(f, lo, hi, xtol=1e-14, rtol=max(rtol, 1e-15))
+    Vc = math.exp(root)
+    # error: the root moves by (error of b) / |db/dlog V| plus the root finder's tolerance
+    h = 1e-4
+    slope = (f(root + h) - f(root - h)) / (2 * h)
+    err_b = max(e["error"] for e in evaluations[-3:])
+    error = Vc * (abs(err_b / slope) + rtol)
+    return Vc, error, "converged", f"b(V) = 1 at V = {Vc:.12g} (relative error {error / Vc:.1e})", evaluations
