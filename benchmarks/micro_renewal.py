@@ -1,0 +1,128 @@
+"""Run time against error of the direct steady-sliding solver (micro.renewal), V^c per k0,
+and the Fokker-Planck's stored steady stresses scored against the exact stress.
+
+1. ``grid``: for the paper's parameters (k1 = 0.1, k2 = 0.9, zbar = 0.1, exponential g)
+   and the (k1, k2) = (0, 1) set at small k0, the error of sigma and of the branching ratio
+   b on a fixed grid of n nodes against the finest grid (n = 160), with the run time of
+   one solve (median of repeats, after compilation).
+2. ``default``: micro.steady_sliding at its default tolerance, time per V and error.
+3. ``vc``: micro.critical_velocity (method "renewal") for the paper's five k0 and the four
+   (k1, k2) sets of Fig. 5: time, its error estimate, and the change against a run at
+   tolerance 1e-13.
+4. ``fp``: the rows of results/micro_eps_convergence.csv (Fokker-Planck steady stress
+   against the bin eps) with their true error against the exact stress, and the measured
+   order of the FP in eps (least squares of log error on log eps).
+
+Compile time is reported apart (the first call in a fresh process).  Writes
+benchmarks/results/micro_renewal_{grid,default,vc,fp}.csv.
+
+    python benchmarks/micro_renewal.py          # about a minute
+"""
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+import micro
+from micro import renewal as R
+
+RESULTS = Path(__file__).parent / "results"
+PAPER_K0 = (0.3, 0.1, 0.01, 1e-3, 1e-4)
+SETS = ((0.1, 0.9), (0.0, 1.0), (0.5, 0.5), (0.9, 0.1))
+
+
+def median_time(fn, repeats: int = 7) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def grid_table() -> pd.DataFrame:
+    rows = []
+    cases = [(0.1, 0.1, 0.9, V) for V in (0.05, 0.9, 20.0, 1e4)] + [(1e-3, 0.0, 1.0, 100.0), (1e-4, 0.0, 1.0, 10.0)]
+    for k0, k1, k2, V in cases:
+        model = micro.Model(k0=k0, k1=k1, k2=k2)
+        quad = R._quadrature(model, V)
+        width = R._map_width(model)
+        ref = R._Chain.solve(model, V, quad, R._Grid.build(160, 0.0, width))
+        for n in (8, 12, 16, 24, 32, 48, 64, 96):
+            grid = R._Grid.build(n, 0.0, width)
+            chain = R._Chain.solve(model, V, quad, grid)
+            wall = median_time(lambda: R._Chain.solve(model, V, quad, grid))
+            rows.append(dict(k0=k0, k1=k1, k2=k2, V=V, n=n, n_z=quad.z.size, wall_ms=1e3 * wall,
+                             sigma_error=abs(chain.sigma - ref.sigma),
+                             b_error=abs(chain.branching_ratio - ref.branching_ratio),
+                             wait_error=abs(chain.wait_error)))
+    return pd.DataFrame(rows)
+
+
+def default_table() -> pd.DataFrame:
+    rows = []
+    for k0 in PAPER_K0:
+        model = micro.Model(k0=k0)
+        Vc = micro.critical_velocity(model).Vc
+        for V in (0.5 * Vc, 1.5 * Vc, 10 * Vc, 1e4):
+            res = micro.steady_sliding(model, V, growth_rate=False)
+            quad = R._quadrature(model, V)
+            ref = R._Chain.solve(model, V, quad, R._Grid.build(160, 0.0, R._map_width(model)))
+            wall = median_time(lambda: micro.steady_sliding(model, V, growth_rate=False))
+            rows.append(dict(k0=k0, V=V, n=int(res.n_nodes), wall_ms=1e3 * wall, sigma=float(res.sigma),
+                             sigma_error=abs(float(res.sigma) - ref.sigma), estimate=float(res.sigma_error),
+                             b_error=abs(float(res.branching_ratio) - ref.branching_ratio)))
+    return pd.DataFrame(rows)
+
+
+def vc_table() -> pd.DataFrame:
+    rows = []
+    for k1, k2 in SETS:
+        for k0 in PAPER_K0:
+            model = micro.Model(k0=k0, k1=k1, k2=k2)
+            t0 = time.perf_counter()
+            crit = micro.critical_velocity(model)
+            wall = time.perf_counter() - t0
+            tight, _, _, _, _ = R.critical_velocity_renewal(model, V_max=1e7, tol=1e-13)
+            rows.append(dict(k1=k1, k2=k2, k0=k0, Vc=crit.Vc, status=crit.status, wall_s=wall,
+                             error_estimate=(crit.V_high - crit.Vc) if crit.Vc > 0 else 0.0,
+                             change_at_tol_1e13=abs(tight - crit.Vc),
+                             k0_Vc_over_asymptote=crit.Vc / micro.vc_small_k0(model), evaluations=len(crit.evaluations)))
+    return pd.DataFrame(rows)
+
+
+def fp_table() -> tuple[pd.DataFrame, pd.DataFrame]:
+    fp = pd.read_csv(RESULTS / "micro_eps_convergence.csv")
+    fp = fp[(fp.regime == "steady") & fp.converged.astype(bool)].copy()
+    fp["sigma_exact"] = [float(micro.steady_sliding(micro.Model(k0=k0), V, growth_rate=False).sigma)
+                         for k0, V in zip(fp.k0, fp.V)]
+    fp["true_error"] = fp.sigma - fp.sigma_exact
+    orders = []
+    for (k0, V), g in fp.groupby(["k0", "V"]):
+        if len(g) >= 2:
+            p = np.polyfit(np.log(g.eps), np.log(np.abs(g.true_error)), 1)[0]
+            orders.append(dict(k0=k0, V=V, n_eps=len(g), order=p, largest_error=g.true_error.abs().max(),
+                               smallest_error=g.true_error.abs().min()))
+    return fp[["k0", "V", "eps", "sigma", "sigma_exact", "true_error", "extrapolation", "wall_s"]], pd.DataFrame(orders)
+
+
+def main() -> None:
+    t0 = time.perf_counter()
+    micro.steady_sliding(micro.Model(k0=0.1), 2.0)
+    print(f"compile (first call, numba cache cold or warm): {time.perf_counter() - t0:.2f} s")
+    RESULTS.mkdir(exist_ok=True)
+    for name, frame in (("grid", grid_table()), ("default", default_table()), ("vc", vc_table())):
+        frame.to_csv(RESULTS / f"micro_renewal_{name}.csv", index=False)
+        print(f"\n## {name}\n" + frame.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
+    fp, orders = fp_table()
+    fp.to_csv(RESULTS / "micro_renewal_fp.csv", index=False)
+    print("\n## fp\n" + fp.to_string(index=False, float_format=lambda x: f"{x:.6g}"))
+    print("\n## fp order in eps\n" + orders.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
+
+
+if __name__ == "__main__":
+    main()

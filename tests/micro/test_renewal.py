@@ -1,0 +1,209 @@
+"""The direct solution of steady sliding (micro.renewal): against closed forms, an
+independent Monte Carlo of the same blocks, its own limits, and the FP / N-block V^c.
+
+Every reference here shares no code with micro.renewal: the closed forms are
+micro.analytic's (derived independently in docs/micro_model.md), the Monte Carlo below
+time-steps the blocks' equations with a plain numpy loop.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import micro
+from micro import renewal as R
+from micro.cli import main as micro_main
+
+PAPER = micro.Model(k0=0.1)  # k1 = 0.1, k2 = 0.9, zbar = 0.1, exponential jumps
+
+
+@pytest.mark.parametrize("eta_u, f_th, zbar, k0", [(1.0, 1.0, 0.1, 0.1), (2.5, 0.7, 0.3, 0.02), (0.4, 3.0, 0.05, 0.5)])
+@pytest.mark.parametrize("V", [1e-3, 0.3, 7.0, 2e3])
+def test_deterministic_jumps_reproduce_eq4(eta_u, f_th, zbar, k0, V):
+    # Newton on the fixed point of the 1-D map; a wrong jump, relaxation or stress formula
+    # misses Eq. (4) by O(zbar k2) ~ 1e-2, a scaling error in eta_u or f_th by far more
+    model = micro.Model(k0=k0, eta_u=eta_u, f_th=f_th, jumps=micro.Deterministic(zbar))
+    res = micro.steady_sliding(model, V, growth_rate=False)
+    # (Eq. (4) itself loses ~1e-16 eta_u V to cancellation at large V)
+    assert float(res.sigma) == pytest.approx(micro.sigma_deterministic_steady(model, V), abs=2e-13 + 1e-15 * eta_u * V)
+    assert abs(float(res.wait_error)) < 1e-10  # each block jumps every zbar / V (a wrong map: O(1))
+
+
+def test_no_dashpot_is_an_exact_renewal_process():
+    model = micro.Model(k0=0.2, k1=0.3, k2=0.0)
+    res = micro.steady_sliding(model, [0.01, 1.0, 100.0])
+    assert np.allclose(res.sigma, 1.0 - 0.5 * model.jumps.mean_residual, atol=1e-15)
+    assert np.all(res.stable) and np.allclose(res.branching_ratio, 0.3 / 0.5)
+
+
+@pytest.mark.parametrize("k1, k2", [(0.1, 0.9), (0.0, 1.0), (0.5, 0.5)])
+def test_large_velocity_expansion(k1, k2):
+    # sigma = f_th - kappa <z^2>/(2 zbar) + k2 gamma Var(R) / V + O(V^-2): at V = 1e4 the
+    # 1/V term is 8e-7 (k2 = 0.9); the remainder must be O(1e-10)
+    model = micro.Model(k0=0.1, k1=k1, k2=k2)
+    V = 1e4
+    sigma = float(micro.steady_sliding(model, V, growth_rate=False).sigma)
+    first_order = micro.sigma_fast_limit(model, V) - micro.sigma_fast_limit(model)
+    assert abs(sigma - micro.sigma_fast_limit(model, V)) < 1e-3 * first_order  # O(V^-2) remainder
+    assert first_order > 2e-7
+
+
+def test_small_velocity_expansion_for_stiff_drive():
+    # k0 > k2: sigma = f_th - (k0+k1) <z^2>/(2 zbar) - eta_u V + O(V^2)
+    # the remainder is measured second order: (sigma - limit) / V^2 settles (9.6 here)
+    model = micro.Model(k0=1.2, k2=0.9)
+    ratios = []
+    for V in (1e-3, 1e-4, 1e-5):
+        sigma = float(micro.steady_sliding(model, V, growth_rate=False).sigma)
+        ratios.append((sigma - micro.sigma_slow_limit(model, V)) / V**2)
+        assert abs(sigma - micro.sigma_slow_limit(model, 0.0)) > 0.5 * V  # the eta_u V term is seen
+    assert abs(ratios[2] - ratios[1]) < 0.02 * abs(ratios[1]) and abs(ratios[1]) < 20.0
+
+
+@pytest.mark.parametrize("k0, k1, k2", [(0.1, 0.1, 0.9), (1e-4, 0.0, 1.0), (0.01, 0.5, 0.5), (0.003, 0.9, 0.1)])
+@pytest.mark.parametrize("V", [1e-3, 0.5, 30.0, 1e4])
+def test_mean_waiting_time_is_zbar_over_V(k0, k1, k2, V):
+    # stationarity of the spring's deficit forces E[T] = zbar / V exactly; a wrong
+    # stationary measure misses it at O(1)
+    res = micro.steady_sliding(micro.Model(k0=k0, k1=k1, k2=k2), V, growth_rate=False)
+    assert abs(float(res.wait_error)) < 1e-7
+    assert float(res.sigma_error) < 1e-9
+
+
+def test_geometric_convergence_in_the_grid():
+    # paper parameters near V^c: errors against the finest grid fall by > 1e3 from 12 to 32 nodes
+    model, V = PAPER, 0.9
+    quad = R._quadrature(model, V)
+    sig = {n: R._Chain.solve(model, V, quad, R._Grid.build(n, 0.0, math.inf)) for n in (8, 12, 16, 24, 64)}
+    err = {n: abs(sig[n].branching_ratio - sig[64].branching_ratio) for n in (8, 12, 16, 24)}
+    assert err[24] < 1e-3 * err[8] and err[24] < 1e-9
+    assert err[16] < err[12] < err[8]
+
+
+def _monte_carlo(model: micro.Model, V: float, n_blocks: int, n_steps: int, dt: float, seed: int):
+    """Independent blocks driven at V, time-stepped: spring stretch e relaxes exactly over
+    dt, the margin falls by a V dt + k2 (change of e), a block whose margin is <= 0 jumps
+    by z ~ g (margin + kappa z, e - z).  Returns the time-averaged margin and the density
+    of margins near 0 (blocks per unit margin), after a burn-in."""
+    rng = np.random.default_rng(seed)
+    a, k2, gamma = model.k0 + model.k1, model.k2, model.gamma
+    e = -model.jumps.sample(rng, n_blocks) * rng.random(n_blocks)  # near its mean 0
+    margin = model.kappa * model.jumps.sample(rng, n_blocks) * rng.random(n_blocks)
+    decay = math.exp(-gamma * dt)
+    sums, near, count = 0.0, 0, 0
+    width = 0.02 * a * model.zbar
+    for step in range(n_steps):
+        e_new = V / gamma + (e - V / gamma) * decay
+        margin -= a * V * dt + k2 * (e_new - e)
+        e = e_new
+        jump = margin <= 0.0
+        if jump.any():
+            z = model.jumps.sample(rng, int(jump.sum()))
+            margin[jump] += model.kappa * z
+            e[jump] -= z
+        if step > n_steps // 4:
+            sums += margin.mean()
+            near += int(np.count_nonzero(margin < width))
+            count += 1
+    return sums / count, near / (count * n_blocks * width)
+
+
+def test_independent_monte_carlo_of_the_blocks():
+    # k0 = 0.1, V = 2 (steady branch): a jump size (kappa) or relaxation (gamma) error in
+    # the chain moves sigma by >= 1e-2 and b by >= 5e-2; the Monte Carlo resolves 2e-3
+    model, V = PAPER, 2.0
+    res = micro.steady_sliding(model, V, growth_rate=False)
+    mean_margin, density = _monte_carlo(model, V, n_blocks=2000, n_steps=8000, dt=model.zbar / V / 50, seed=3)
+    assert model.f_th - mean_margin == pytest.approx(float(res.sigma), abs=2e-3)
+    assert density * model.zbar * (model.k1 + model.k2) == pytest.approx(float(res.branching_ratio), abs=0.05)
+
+
+def test_characteristic_function_limits_and_the_growth_rate():
+    model = PAPER
+    for V in (0.3, 2.0):
+        res = micro.steady_sliding(model, V)
+        G = micro.characteristic_function(model, V, [1e-7, 1e8])
+        assert G[0].real == pytest.approx(model.k1 / (model.k0 + model.k1), abs=1e-5)  # G(0+) = k1 / (k0 + k1)
+        assert G[1].real == pytest.approx(float(res.branching_ratio), abs=1e-6)  # G(inf) = b
+        if V < 0.7:
+            lam = float(res.growth_rate)
+            assert lam > 0 and not bool(res.stable)
+            assert micro.characteristic_function(model, V, lam).real[()] == pytest.approx(1.0, abs=1e-8)
+        else:
+            assert bool(res.stable) and math.isnan(float(res.growth_rate))
+
+
+def test_one_unstable_root_below_the_critical_velocity_none_above():
+    # argument principle along the imaginary axis, away from V^c where the phase settles
+    model = micro.Model(k0=0.3)
+    Vc = micro.critical_velocity(model).Vc
+    assert micro.unstable_mode_count(model, 0.3 * Vc, n_omega=400) == 1
+    assert micro.unstable_mode_count(model, 3.0 * Vc, n_omega=400) == 0
+
+
+def test_growth_rate_diverges_at_the_critical_velocity():
+    # a real root enters from lambda = +inf as b crosses 1
+    model = PAPER
+    Vc = micro.critical_velocity(model).Vc
+    rates = micro.steady_sliding(model, [0.5 * Vc, 0.9 * Vc, 0.99 * Vc]).growth_rate
+    assert np.all(np.diff(rates) > 0) and rates[-1] > 10 * rates[0]
+
+
+def test_critical_velocity_inside_the_fokker_planck_and_n_block_brackets():
+    # independent brackets (docs/micro_numerics.md §5, micro_results.md): FP bisection with
+    # the check at eps/2 and N-block amplitudes: k0 = 0.3: 0.19-0.21 (FP 0.186-0.191),
+    # k0 = 0.1: 0.70-0.75 (FP 0.725-0.744), k0 = 0.01: 7.5-8.0 (FP 7.85-7.95)
+    expected = {0.3: (0.18, 0.21), 0.1: (0.70, 0.75), 0.01: (7.5, 8.1)}
+    for k0, (lo, hi) in expected.items():
+        crit = micro.critical_velocity(micro.Model(k0=k0))
+        assert crit.status == "converged" and lo < crit.Vc < hi
+        assert crit.V_high - crit.V_low < 1e-8 * crit.Vc
+        assert abs(float(micro.steady_sliding(micro.Model(k0=k0), crit.Vc, growth_rate=False).branching_ratio) - 1) < 1e-10
+
+
+def test_critical_velocity_small_k0_asymptote_and_stiff_drive():
+    for k1, k2 in ((0.1, 0.9), (0.5, 0.5)):
+        model = micro.Model(k0=1e-4, k1=k1, k2=k2)
+        crit = micro.critical_velocity(model)
+        assert crit.Vc / micro.vc_small_k0(model) == pytest.approx(1.0, abs=3e-3)
+    crit = micro.critical_velocity(micro.Model(k0=0.95))  # k0 >= k2
+    assert crit.Vc == 0.0 and crit.status == "no stick-slip" and not crit.evaluations
+
+
+def test_stationary_takes_stable_steady_rows_from_the_chain():
+    res = micro.stationary(PAPER, 5.0)
+    assert res.regime == "steady" and res.converged and "renewal chain" in res.message
+    assert res.sigma_mean == float(micro.steady_sliding(PAPER, 5.0, growth_rate=False).sigma)
+    frame = micro.sweep(PAPER, [5.0, 50.0])
+    assert list(frame.regime) == ["steady", "steady"] and frame.wall_time.max() < 1.0
+
+
+def test_bad_input_is_refused_before_computing():
+    with pytest.raises(ValueError, match="V must be finite and in"):
+        micro.steady_sliding(PAPER, [1.0, float("nan")])
+    with pytest.raises(ValueError, match="V must be finite and in"):
+        micro.steady_sliding(PAPER, -1.0)
+    with pytest.raises(ValueError, match="tol must be"):
+        micro.steady_sliding(PAPER, 1.0, tol=0.0)
+    with pytest.raises(ValueError, match="method must be"):
+        micro.critical_velocity(PAPER, method="bisect")
+
+
+def test_cli_steady_writes_the_documented_columns(tmp_path, capsys):
+    out = tmp_path / "steady.csv"
+    assert micro_main(["steady", "--k0", "0.1", "--V", "0.5,2", "--out", str(out)]) == 0
+    frame = pd.read_csv(out)
+    assert list(frame.columns[:8]) == ["k0", "k1", "k2", "zbar", "V", "sigma", "branching_ratio", "stable"]
+    assert list(frame.stable) == [False, True] and frame.growth_rate.iloc[0] > 0
+    assert frame.sigma.iloc[1] == pytest.approx(0.893759123072792, abs=1e-11)
+
+
+def test_cli_critical_is_direct_by_default(tmp_path):
+    out = tmp_path / "vc.csv"
+    assert micro_main(["critical", "--k0", "0.1,1", "--out", str(out)]) == 0
+    frame = pd.read_csv(out)
+    assert list(frame.columns[:5]) == ["k0", "k1", "k2", "zbar", "Vc"]
+    assert frame.Vc.iloc[0] == pytest.approx(0.72750434069, rel=1e-9) and frame.Vc.iloc[1] == 0.0
