@@ -80,10 +80,6 @@ class _Quadrature:
     weight: np.ndarray  # probabilities, summing to 1
     deterministic: bool
 
-    @property
-    def zbar(self) -> float:
-        return float(self.weight @ self.z)
-
 
 def _panels(lo_scale: float, zbar: float, z_top: float) -> np.ndarray:
     """Panel ends: doubling from ``lo_scale`` up to ``zbar`` (at small V the waiting time
@@ -382,8 +378,8 @@ def unstable_mode_count(model: Model, V: float, *, omega_max: float | None = Non
     G = characteristic_function(model, V, 1j * omega, tol=tol) - 1.0
     phase = np.unwrap(np.angle(G))
     turns = (phase[-1] - phase[0]) / math.pi
-    tail = abs(G[-1] - (G[-1].real))  # the end of the axis must have settled near b - 1
-    if not (abs(turns - round(turns)) < 0.05 and tail < 0.5 * abs(G[-1].real)):
+    settled = abs(G[-1].imag) < 0.5 * abs(G[-1].real)  # the end of the axis must be near b - 1, real
+    if not (abs(turns - round(turns)) < 0.05 and settled):
         log.warning("unstable_mode_count(V=%g): the phase has not settled (%.3f turns, G(i omega_max)-1 = %s)",
                     V, turns, G[-1])
     return int(round(-turns))

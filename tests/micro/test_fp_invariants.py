@@ -240,6 +240,8 @@ def test_cycle_amplitude_is_the_median_drop_of_the_later_half():
     assert solver._cycle_amplitude(solver.Stationary(regime="steady", **common)) == 0.0
 
 
+@pytest.mark.slow  # 3.5 min on one core (N-block at N = 1e5, then the FP bisection); the
+# default run checks the direct V^c against the same brackets (test_renewal.py)
 def test_the_check_at_half_the_bin_brackets_the_n_block_critical_velocity():
     # k0 = 0.3 at the phase diagram's coarse bin eps = 0.025.  The N-block (N = 1e5,
     # stepped down from steady sliding at V = 2, as benchmarks/micro_hopf_amplitude.py)

@@ -207,3 +207,14 @@ def test_cli_critical_is_direct_by_default(tmp_path):
     frame = pd.read_csv(out)
     assert list(frame.columns[:5]) == ["k0", "k1", "k2", "zbar", "Vc"]
     assert frame.Vc.iloc[0] == pytest.approx(0.72750434069, rel=1e-9) and frame.Vc.iloc[1] == 0.0
+
+
+def test_tabulated_jumps_meet_the_large_velocity_expansion():
+    # uniform g on [0, 0.2] (zbar = 0.1, <z^2>/(2 zbar) = 0.0667): the expansion's moments
+    # come from Tabulated's own trapezoidal cdf, the chain's from its Gauss-Legendre panels
+    model = micro.Model(k0=0.1, jumps=micro.Tabulated(pdf=lambda z: np.ones_like(z), support_max=0.2))
+    V = 3e3
+    sigma = float(micro.steady_sliding(model, V, growth_rate=False).sigma)
+    first_order = micro.sigma_fast_limit(model, V) - micro.sigma_fast_limit(model)
+    assert abs(sigma - micro.sigma_fast_limit(model, V)) < 1e-2 * first_order
+    assert micro.critical_velocity(model).Vc > 0
