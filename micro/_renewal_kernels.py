@@ -25,9 +25,11 @@ MAX_NEWTON = 80
 def waiting_time(zeta: float, D: float, alpha: float, beta: float) -> float:
     """Root t > 0 of ``alpha t + beta D (1 - e^-t) = zeta``: the time to the next jump.
 
-    The left side is increasing and concave in t, so Newton from the lower bound
-    ``zeta / (alpha + beta D)`` increases monotonically to the root; the bracket guards
-    against round-off.
+    The left side F + zeta is increasing and concave in t, so Newton from a lower bound
+    increases monotonically to the root.  Two lower bounds: ``zeta / (alpha + beta D)``
+    (the tangent at 0) and, for a long wait, ``(zeta - beta D) / alpha`` (where F =
+    -beta D e^-t < 0).  Once a step is below 1e-9 t the next iterate is exact to
+    round-off (quadratic convergence): take it and stop.  The bracket guards round-off.
     """
     if zeta <= 0.0:
         return 0.0
@@ -35,6 +37,7 @@ def waiting_time(zeta: float, D: float, alpha: float, beta: float) -> float:
     hi = math.inf
     if alpha > 0.0:
         hi = zeta / alpha
+        lo = max(lo, (zeta - beta * D) / alpha)
     if zeta < beta * D:
         hi = min(hi, -math.log1p(-zeta / (beta * D)))
     t = lo
@@ -49,7 +52,7 @@ def waiting_time(zeta: float, D: float, alpha: float, beta: float) -> float:
         tn = t - step
         if not (lo <= tn <= hi):
             tn = 0.5 * (lo + hi) if math.isfinite(hi) else 2.0 * t
-        if abs(tn - t) <= 2e-16 * tn:
+        if abs(tn - t) <= 1e-9 * tn:
             return tn
         t = tn
     return t
