@@ -654,10 +654,9 @@ def critical_velocity(
     ``b(V) = 1``, the branching ratio of steady sliding from the renewal chain
     (:func:`micro.steady_sliding`; derivation in docs/micro_renewal.md), to ~1e-10
     relative in a fraction of a second.  ``V_min`` and ``V_max`` (default 1e7 here, 1e3
-    for the bisection) bound the search; the
-    other options belong to ``method="fp"``.  ``k0 >= k2``: Vc = 0 at once (steady
-    sliding is stable at every V).  ``V_low`` and ``V_high`` are ``Vc`` minus and plus
-    its error estimate.
+    for the bisection) bound the search; the other options belong to ``method="fp"``.
+    ``k0 >= k2``: Vc = 0 at once (steady sliding is stable at every V).  ``V_low`` and
+    ``V_high`` are ``Vc`` minus and plus its error estimate.
 
     ``method="fp"``: bisection on the regime of Fokker-Planck runs (the paper's
     Appendix B), kept for cross-checks.

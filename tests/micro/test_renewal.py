@@ -260,3 +260,61 @@ def test_characteristic_function_against_an_open_loop_simulation():
                                 seed=2)
     exact = micro.characteristic_function(model, V, 1j * np.asarray(omegas))
     assert np.all(np.abs(simulated - exact) < 0.015), (simulated, exact)
+
+
+def test_kernels_agree_with_a_plain_numpy_twin():
+    # the generator, mean waiting time and margin integral of the jitted assembly against
+    # scipy's root finder and scipy's barycentric interpolation, on a small sinh-mapped grid
+    from scipy.interpolate import BarycentricInterpolator
+    from scipy.optimize import brentq
+
+    from micro import _renewal_kernels as RK
+
+    model, V = micro.Model(k0=0.01, k1=0.0, k2=1.0), 3.0
+    quad = R._quadrature(model, V)
+    grid = R._Grid.build(9, 0.0, 0.02)
+    alpha, beta = model.k0 / model.kappa, model.k2 / model.kappa
+    zeta = model.gamma * quad.z / V
+    Q, Et, EI, _, _, _ = RK.assemble(grid.x, grid.theta, grid.bw, zeta, quad.weight, alpha, beta,
+                                     grid.c, grid.w, grid.mu, grid.nu, False)
+    M = np.zeros_like(Q)
+    Et_ref, EI_ref = np.zeros(9), np.zeros(9)
+    for i, x in enumerate(grid.x):
+        for z, wq in zip(zeta, quad.weight):
+            D = x + z
+            t = brentq(lambda s: alpha * s + beta * D * (1 - np.exp(-s)) - z, 0.0, z / alpha + 1.0, xtol=1e-300,
+                       rtol=4 * np.finfo(float).eps)
+            theta = (np.arcsinh((D * np.exp(-t) - grid.c) / grid.w) - grid.mu) / grid.nu
+            for j in range(9):
+                unit = np.zeros(9)
+                unit[j] = 1.0
+                M[i, j] += wq * BarycentricInterpolator(grid.theta, unit)(theta)
+            Et_ref[i] += wq * t
+            EI_ref[i] += wq * (z * t - alpha * t**2 / 2 - beta * D * (t - 1 + np.exp(-t)))
+    assert np.allclose(Q + np.eye(9), M, atol=1e-11)
+    assert np.allclose(Et, Et_ref, rtol=1e-12) and np.allclose(EI, EI_ref, rtol=1e-9, atol=1e-15)
+
+
+@pytest.mark.parametrize("jumps", [micro.Exponential(0.1, 10.0), micro.Deterministic(0.1),
+                                   micro.Tabulated(pdf=lambda z: z * np.exp(-z / 0.05), support_max=2.0)],
+                         ids=["exponential", "deterministic", "tabulated"])
+def test_stress_every_set_and_distribution_across_k0_and_V(jumps):
+    # the supported range: k0 from 1e-4 to 1, V from 1e-3 to 1e4, the four (k1, k2) sets of
+    # Fig. 5.  Velocity weakening (sigma decreasing in V) and a branching ratio decreasing
+    # in V (so that b(V) = 1 has one root) hold at every point; the full sweep (1584
+    # points, 46 s) is in docs/micro_renewal.md
+    V = np.geomspace(1e-3, 1e4, 12)
+    for k1, k2 in ((0.1, 0.9), (0.0, 1.0), (0.5, 0.5), (0.9, 0.1)):
+        for k0 in (1e-4, 0.03, 1.0):
+            res = micro.steady_sliding(micro.Model(k0=k0, k1=k1, k2=k2, jumps=jumps), V, growth_rate=False, warn=False)
+            assert np.all(np.isfinite(res.sigma)) and np.all(np.isfinite(res.branching_ratio))
+            assert np.all(np.diff(res.sigma) < 1e-12) and np.all(np.diff(res.branching_ratio) < 1e-9)
+            assert np.all(res.sigma_error < 1e-8) and np.all(np.abs(res.wait_error) < 1e-7)
+
+
+def test_characteristic_function_limits_for_deterministic_jumps():
+    model = micro.Model(k0=0.1, jumps=micro.Deterministic(0.1))
+    for V in (0.3, 2.0):
+        b = float(micro.steady_sliding(model, V, growth_rate=False).branching_ratio)
+        G = micro.characteristic_function(model, V, [1e-7, 1e7])
+        assert G[0].real == pytest.approx(0.5, abs=1e-5) and G[1].real == pytest.approx(b, abs=1e-5)
