@@ -7,8 +7,8 @@ time t that solves
 
     alpha * t + beta * D * (1 - exp(-t)) = zeta,        alpha = (k0+k1)/kappa, beta = k2/kappa,
 
-and arrives there with deficit ``x' = D * exp(-t)``.  Each kernel has a plain-numpy
-twin in the tests (``tests/micro/test_renewal.py``).
+and arrives there with deficit ``x' = D * exp(-t)``.  The assembly, and through it
+every kernel here, has a plain-numpy twin in the tests (``tests/micro/test_renewal.py``).
 """
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
-#: Newton iterations of the waiting time before giving up (it converges in < 10).
+#: Newton iterations of the waiting time before giving up (it takes a few).
 MAX_NEWTON = 80
 
 
@@ -71,22 +71,6 @@ def phi2(t: float) -> float:
             total += term
         return total
     return (t + math.expm1(-t)) / (t * t)
-
-
-@njit(cache=True)
-def x_to_theta(x: float, c: float, w: float, mu: float, nu: float) -> float:
-    """Grid coordinate theta in [-1, 1] of a deficit x in [0, 1]: the sinh map
-    ``x = c + w sinh(mu + nu theta)``, or the affine map when ``w`` is infinite."""
-    if not math.isfinite(w):
-        return 2.0 * x - 1.0
-    return (math.asinh((x - c) / w) - mu) / nu
-
-
-@njit(cache=True)
-def dtheta_dx(x: float, c: float, w: float, mu: float, nu: float) -> float:
-    if not math.isfinite(w):
-        return 2.0
-    return 1.0 / (nu * math.sqrt(w * w + (x - c) * (x - c)))
 
 
 @njit(cache=True)
@@ -147,11 +131,10 @@ def assemble(xn, thn, bw, zeta, wz, alpha, beta, c, w, mu, nu, store):
     ``M[i, j] = E_z l_j(x'(x_i, z))``, with each diagonal entry set to minus the sum of its
     row's off-diagonal ones (the basis sums to 1): near the identity (large V, small k0)
     the off-diagonal entries keep their relative accuracy where ``M - I`` would lose it.
-    Also returns the
-    mean waiting time ``Et[i]`` and the mean integral of the margin over a waiting time
-    ``EI[i]`` from each node; with ``store``, also the waiting times ``t[i, q]``, the
-    arrival deficits ``xp[i, q]`` and the basis rows ``L[i, q, :]`` at the arrivals
-    (for the linear stability); otherwise empty arrays.
+    Also returns the mean waiting time ``Et[i]`` and the mean integral of the margin over
+    a waiting time ``EI[i]`` from each node; with ``store``, also the waiting times
+    ``t[i, q]``, the arrival deficits ``xp[i, q]`` and the basis rows ``L[i, q, :]`` at
+    the arrivals (for the linear stability); otherwise empty arrays.
     """
     n = xn.shape[0]
     nq = zeta.shape[0]
