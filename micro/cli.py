@@ -88,7 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     _model_options(st)
     st.add_argument("--V", required=True, help="drive velocities, comma-separated, each in [1e-6, 1e7]")
     st.add_argument("--no-growth-rate", dest="growth_rate", action="store_false",
-                    help="skip the growth rate of the unstable mode (about 0.1 s per unstable V)")
+                    help="skip the growth rate of the unstable mode (about 0.03 s per unstable V)")
     st.add_argument("--out", required=True,
                     help="output CSV: k0,k1,k2,zbar,V,sigma,branching_ratio,stable,growth_rate,sigma_error,converged")
 
