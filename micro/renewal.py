@@ -69,7 +69,7 @@ def _check_velocities(V) -> np.ndarray:
         raise ValueError(f"V must be a number or an array of numbers, got {V!r}") from None
     bad = ~(np.isfinite(v) & (v >= V_RANGE[0]) & (v <= V_RANGE[1]))
     if np.any(bad):
-        raise ValueError(f"V must be finite and in [{V_RANGE[0]:g}, {V_RANGE[1]:g}], got {v[bad].ravel()[0]!r}")
+        raise ValueError(f"V must be finite and in [{V_RANGE[0]:g}, {V_RANGE[1]:g}], got {float(v[bad].ravel()[0])!r}")
     return v
 
 
