@@ -20,7 +20,6 @@ benchmarks/results/micro_renewal_{grid,default,vc,fp}.csv.
 """
 from __future__ import annotations
 
-import math
 import time
 from pathlib import Path
 

@@ -74,6 +74,13 @@ def phi2(t: float) -> float:
 
 
 @njit(cache=True)
+def margin_integral(zeta: float, D: float, t: float, alpha: float, beta: float) -> float:
+    """Integral of the margin from a jump to the next, ``zeta t - alpha t^2/2 - beta D
+    (t - 1 + e^-t)``: a positive integrand, written without cancellation."""
+    return t * (zeta - 0.5 * alpha * t - beta * D * t * phi2(t))
+
+
+@njit(cache=True)
 def displacement(x: float, zeta: float, t: float, alpha: float) -> float:
     """``x' - x`` without cancellation.  From the waiting-time equation,
     ``x' - x = alpha (t - D (1 - e^-t)) = alpha (t (1 - D) + D (t - 1 + e^-t))``, whose terms
@@ -166,8 +173,7 @@ def assemble(xn, thn, bw, zeta, wz, alpha, beta, c, w, mu, nu, store):
                 if j != i:
                     M[i, j] += wq * row[j]
             Et[i] += wq * t
-            # integral of the margin from the jump to the next: zeta t - alpha t^2/2 - beta D (t - 1 + e^-t)
-            EI[i] += wq * t * (z - 0.5 * alpha * t - beta * D * t * phi2(t))
+            EI[i] += wq * margin_integral(z, D, t, alpha, beta)
             if store:
                 T[i, q] = t
                 XP[i, q] = xp

@@ -23,10 +23,10 @@ characteristic equation :math:`G(\lambda) = 1`, with :math:`G(0) = k_1/(k_0 + k_
 enters from :math:`\lambda = +\infty` (:func:`unstable_mode_count` checks that no other
 root is in the right half-plane).
 
-Discretisation: Chebyshev collocation of the chain's expectation operator in x, on a
-sinh map centred where the linearised chain puts the stationary measure (it can be
-narrow: width ~ sqrt(gamma zbar / V) at large V, sqrt(k0/k2) with k1 = 0), and composite
-Gauss-Legendre in z, graded towards z = 0.  The stationary weights are quadrature weights
+Discretisation: Chebyshev collocation of the chain's expectation operator in x (a
+moment method: the stationary measure, however narrow, need not be resolved), on an
+affine map, or a sinh map clustered at x = 0 on the scale (k0 + k1)/k2 when that is
+small, and composite Gauss-Legendre in z, graded towards z = 0.  The stationary weights are quadrature weights
 (they may be negative), not a density.  Deterministic jumps have no density: the chain is
 a 1-D map whose fixed point Newton's method finds (it reproduces Eq. (4)).
 """
@@ -42,6 +42,7 @@ from numpy.polynomial.legendre import leggauss
 from scipy.optimize import brentq
 
 from . import _renewal_kernels as RK
+from .analytic import _check_model
 from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
 
 __all__ = ["SteadySliding", "steady_sliding", "critical_velocity_renewal", "characteristic_function",
@@ -57,9 +58,14 @@ N_START, N_MAX = 32, 384
 V_RANGE = (1e-6, 1e7)
 
 
-def _check_model(model: Model) -> None:
-    if not isinstance(model, Model):
-        raise ValueError(f"model must be a micro.Model, got {type(model).__name__}")
+def _fractions(model: Model) -> tuple[float, float]:
+    """alpha = (k0 + k1) / kappa and beta = k2 / kappa, the chain's two stiffness fractions."""
+    return (model.k0 + model.k1) / model.kappa, model.k2 / model.kappa
+
+
+def _stress(model: Model, V: float, mean_integral: float, zeta_bar: float) -> float:
+    """sigma = f_th - <delta>: the mean margin integral over the mean wait, in physical units."""
+    return model.f_th - model.kappa * (V / model.gamma) * mean_integral / zeta_bar
 
 
 def _check_velocities(V) -> np.ndarray:
@@ -78,7 +84,6 @@ def _check_velocities(V) -> np.ndarray:
 class _Quadrature:
     z: np.ndarray  # pinning distances
     weight: np.ndarray  # probabilities, summing to 1
-    deterministic: bool
 
 
 def _panels(lo_scale: float, zbar: float, z_top: float) -> np.ndarray:
@@ -101,13 +106,12 @@ def _panels(lo_scale: float, zbar: float, z_top: float) -> np.ndarray:
 
 
 def _quadrature(model: Model, V: float, nodes: int = Z_NODES) -> _Quadrature:
-    """Composite Gauss-Legendre for E_z over g, graded towards z = 0 on the scale
-    ``alpha V / gamma`` where the waiting time changes fastest at small V."""
+    """Composite Gauss-Legendre for E_z over g (a density: exponential or tabulated),
+    graded towards z = 0 on the scale ``alpha V / gamma`` where the waiting time changes
+    fastest at small V."""
     jumps = model.jumps
-    if jumps.kind == KIND_DETERMINISTIC:
-        return _Quadrature(np.array([jumps.mean]), np.array([1.0]), True)
     zbar = jumps.mean
-    alpha = (model.k0 + model.k1) / model.kappa
+    alpha, _ = _fractions(model)
     lo_scale = 0.25 * max(alpha * V / model.gamma, 1e-12 * zbar)
     if jumps.kind == KIND_EXPONENTIAL:
         z_top = min(jumps.cutoff, 40.0 * jumps.zbar)
@@ -123,7 +127,7 @@ def _quadrature(model: Model, V: float, nodes: int = Z_NODES) -> _Quadrature:
     if not (np.all(np.isfinite(weight)) and np.all(weight >= 0.0) and weight.sum() > 0.0):
         raise ValueError("the jump distribution's pdf must be finite and >= 0 with positive mass")
     keep = weight > 0.0
-    return _Quadrature(z[keep], weight[keep] / weight.sum(), False)
+    return _Quadrature(z[keep], weight[keep] / weight.sum())
 
 
 # ------------------------------------------------------------------------------ the chain on a grid
@@ -177,8 +181,6 @@ class _Chain:
     V: float
     quad: _Quadrature
     grid: _Grid
-    alpha: float
-    beta: float
     zeta: np.ndarray
     Q: np.ndarray
     Et: np.ndarray
@@ -190,7 +192,7 @@ class _Chain:
 
     @classmethod
     def solve(cls, model: Model, V: float, quad: _Quadrature, grid: _Grid, store: bool = False) -> "_Chain":
-        alpha, beta = (model.k0 + model.k1) / model.kappa, model.k2 / model.kappa
+        alpha, beta = _fractions(model)
         zeta = model.gamma * quad.z / V
         Q, Et, EI, t, xp, L = RK.assemble(grid.x, grid.theta, grid.bw, zeta, quad.weight, alpha, beta,
                                           grid.c, grid.w, grid.mu, grid.nu, store)
@@ -198,7 +200,7 @@ class _Chain:
         # stationary weights: w Q = 0 (Q = M - I), sum(w) = 1, as one nonsingular system
         A = 1.0 / n - Q
         weights = np.linalg.solve(A.T, np.full(n, 1.0 / n))
-        return cls(model, V, quad, grid, alpha, beta, zeta, Q, Et, EI, weights,
+        return cls(model, V, quad, grid, zeta, Q, Et, EI, weights,
                    t if store else None, xp if store else None, L if store else None)
 
     @property
@@ -207,9 +209,7 @@ class _Chain:
 
     @property
     def sigma(self) -> float:
-        m = self.model
-        mean_margin = m.kappa * (self.V / m.gamma) * float(self.weights @ self.EI) / self.zeta_bar
-        return m.f_th - mean_margin
+        return _stress(self.model, self.V, float(self.weights @ self.EI), self.zeta_bar)
 
     @property
     def branching_ratio(self) -> float:
@@ -255,31 +255,30 @@ def _solve_adaptive(model: Model, V: float, tol: float, n_max: int = N_MAX, stor
 
 
 # ------------------------------------------------------------------------------ deterministic jumps
+def _map_derivatives(x: float, zeta: float, alpha: float, beta: float) -> tuple[float, float, float, float]:
+    """For the deterministic 1-D map x -> x'(x, zeta): (t, x', dt/dx, dx'/dx), by implicit
+    differentiation of alpha t + beta D (1 - e^-t) = zeta."""
+    D = x + zeta
+    t = RK.waiting_time(zeta, D, alpha, beta)
+    xp = D * math.exp(-t)
+    t_x = -beta * (-math.expm1(-t)) / (alpha + beta * xp)
+    return t, xp, t_x, math.exp(-t) * (1.0 - D * t_x)
+
+
 def _deterministic(model: Model, V: float) -> tuple[float, float, float, float]:
     """Fixed point x* of the 1-D map x -> x'(x, zbar) by Newton: (x*, t*, sigma, b)."""
-    alpha, beta = (model.k0 + model.k1) / model.kappa, model.k2 / model.kappa
-    zbar = model.jumps.mean
-    zeta = model.gamma * zbar / V
-
-    def step(x):
-        D = x + zeta
-        t = RK.waiting_time(zeta, D, alpha, beta)
-        xp = D * math.exp(-t)
-        t_x = -beta * (-math.expm1(-t)) / (alpha + beta * xp)
-        return xp - x, math.exp(-t) * (1.0 - D * t_x) - 1.0, t
-
+    alpha, beta = _fractions(model)
+    zeta = model.gamma * model.jumps.mean / V
     x = 1.0 / (1.0 + 0.5 * zeta)  # close to zeta / (e^zeta - 1), the exact fixed point
     for _ in range(100):
-        F, dF, t = step(x)
-        x_new = min(max(x - F / dF, 0.0), 1.0)
+        _, xp, _, x_x = _map_derivatives(x, zeta, alpha, beta)
+        x_new = min(max(x - (xp - x) / (x_x - 1.0), 0.0), 1.0)
         if abs(x_new - x) <= 1e-16 * max(x, 1e-300):
             x = x_new
             break
         x = x_new
-    D = x + zeta
-    t = RK.waiting_time(zeta, D, alpha, beta)
-    integral = t * (zeta - 0.5 * alpha * t - beta * D * t * RK.phi2(t))
-    sigma = model.f_th - model.kappa * (V / model.gamma) * integral / zeta
+    t = RK.waiting_time(zeta, x + zeta, alpha, beta)
+    sigma = _stress(model, V, RK.margin_integral(zeta, x + zeta, t, alpha, beta), zeta)
     b = (model.k1 + model.k2) / (model.k0 + model.k1 + model.k2 * x)
     return x, t, sigma, b
 
@@ -302,13 +301,12 @@ def _response_terms(chain_alpha, chain_beta, rho1, t, xp, D, lam):
 def _gain(model: Model, V: float, tol: float):
     """G as a function of lam in chain units (lam / gamma), on one chain built once."""
     rho1 = (model.k1 + model.k2) / model.kappa
-    alpha, beta = (model.k0 + model.k1) / model.kappa, model.k2 / model.kappa
+    alpha, beta = _fractions(model)
     if model.jumps.kind == KIND_DETERMINISTIC:
-        x, t, _, _ = _deterministic(model, V)
+        x, _, _, _ = _deterministic(model, V)
         zeta = model.gamma * model.jumps.mean / V
         D = x + zeta
-        t_x = -beta * (-math.expm1(-t)) / (alpha + beta * x)
-        x_x = math.exp(-t) * (1.0 - D * t_x)
+        t, _, t_x, x_x = _map_derivatives(x, zeta, alpha, beta)
 
         def gain_deterministic(lam: complex) -> complex:
             # on the fixed point: h = 1 / (1 - A), h' from differentiating h = 1 + A h(x'(x))
