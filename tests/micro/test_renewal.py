@@ -83,32 +83,43 @@ def test_geometric_convergence_in_the_grid():
     assert err[16] < err[12] < err[8]
 
 
-def _monte_carlo(model: micro.Model, V: float, n_blocks: int, n_steps: int, dt: float, seed: int):
-    """Independent blocks driven at V, time-stepped: spring stretch e relaxes exactly over
-    dt, the margin falls by a V dt + k2 (change of e), a block whose margin is <= 0 jumps
-    by z ~ g (margin + kappa z, e - z).  Returns the time-averaged margin and the density
-    of margins near 0 (blocks per unit margin), after a burn-in."""
+def _simulate_blocks(model: micro.Model, V: float, *, n_blocks: int, dt: float, t_burn: float, t_meas: float,
+                     seed: int, omegas=(), nu: float = 0.0):
+    """Independent blocks driven by the mean slip velocity v = V (1 + nu sum cos(w t)),
+    time-stepped from the model's equations: the spring stretch e relaxes exactly towards
+    v / gamma over dt, the margin falls by k0 V dt + k1 v dt + k2 (change of e), a block
+    whose margin is <= 0 jumps by z ~ g (margin + kappa z, e - z).  Over [t_burn, t_burn +
+    t_meas] returns the time-averaged margin, the density of margins near 0 (blocks per
+    unit margin) and, for each w, zbar / (V nu) times the Fourier coefficient of the jump
+    rate: G(i w)."""
     rng = np.random.default_rng(seed)
-    a, k2, gamma = model.k0 + model.k1, model.k2, model.gamma
+    gamma = model.gamma
     e = -model.jumps.sample(rng, n_blocks) * rng.random(n_blocks)  # near its mean 0
     margin = model.kappa * model.jumps.sample(rng, n_blocks) * rng.random(n_blocks)
     decay = math.exp(-gamma * dt)
+    width = 0.02 * (model.k0 + model.k1) * model.zbar
     sums, near, count = 0.0, 0, 0
-    width = 0.02 * a * model.zbar
-    for step in range(n_steps):
-        e_new = V / gamma + (e - V / gamma) * decay
-        margin -= a * V * dt + k2 * (e_new - e)
+    acc = np.zeros(len(omegas), dtype=complex)
+    for step in range(int(round((t_burn + t_meas) / dt))):
+        t_mid = (step + 0.5) * dt
+        v = V * (1.0 + nu * sum(math.cos(w * t_mid) for w in omegas))
+        e_new = v / gamma + (e - v / gamma) * decay
+        margin -= model.k0 * V * dt + model.k1 * v * dt + model.k2 * (e_new - e)
         e = e_new
         jump = margin <= 0.0
-        if jump.any():
-            z = model.jumps.sample(rng, int(jump.sum()))
+        n = int(jump.sum())
+        if n:
+            z = model.jumps.sample(rng, n)
             margin[jump] += model.kappa * z
             e[jump] -= z
-        if step > n_steps // 4:
+        if t_mid > t_burn:
             sums += margin.mean()
             near += int(np.count_nonzero(margin < width))
             count += 1
-    return sums / count, near / (count * n_blocks * width)
+            if omegas:
+                acc += n * np.exp(-1j * np.asarray(omegas) * t_mid)
+    gain = 2.0 * acc / (n_blocks * t_meas) * model.zbar / (V * nu) if omegas else acc
+    return sums / count, near / (count * n_blocks * width), gain
 
 
 def test_independent_monte_carlo_of_the_blocks():
@@ -116,7 +127,9 @@ def test_independent_monte_carlo_of_the_blocks():
     # the chain moves sigma by >= 1e-2 and b by >= 5e-2; the Monte Carlo resolves 2e-3
     model, V = PAPER, 2.0
     res = micro.steady_sliding(model, V, growth_rate=False)
-    mean_margin, density = _monte_carlo(model, V, n_blocks=2000, n_steps=8000, dt=model.zbar / V / 50, seed=3)
+    dt = model.zbar / V / 50
+    mean_margin, density, _ = _simulate_blocks(model, V, n_blocks=2000, dt=dt, t_burn=2000 * dt, t_meas=6000 * dt,
+                                               seed=3)
     assert model.f_th - mean_margin == pytest.approx(float(res.sigma), abs=2e-3)
     assert density * model.zbar * (model.k1 + model.k2) == pytest.approx(float(res.branching_ratio), abs=0.05)
 
@@ -220,33 +233,6 @@ def test_tabulated_jumps_meet_the_large_velocity_expansion():
     assert micro.critical_velocity(model).Vc > 0
 
 
-def _open_loop_gain(model, V, omegas, nu, n_blocks, dt, t_burn, t_meas, seed):
-    """Independent blocks driven by the mean slip velocity v = V (1 + nu sum cos(w t)),
-    time-stepped as in _monte_carlo; returns zbar / (V nu) times the Fourier coefficient of
-    the jump rate at each w over [t_burn, t_burn + t_meas] (whole periods): G(i w)."""
-    rng = np.random.default_rng(seed)
-    gamma = model.gamma
-    e = -model.jumps.sample(rng, n_blocks) * rng.random(n_blocks)
-    margin = model.kappa * model.jumps.sample(rng, n_blocks) * rng.random(n_blocks)
-    decay = math.exp(-gamma * dt)
-    acc = np.zeros(len(omegas), dtype=complex)
-    for step in range(int(round((t_burn + t_meas) / dt))):
-        t_mid = (step + 0.5) * dt
-        v = V * (1.0 + nu * sum(math.cos(w * t_mid) for w in omegas))
-        e_new = v / gamma + (e - v / gamma) * decay
-        margin -= model.k0 * V * dt + model.k1 * v * dt + model.k2 * (e_new - e)
-        e = e_new
-        jump = margin <= 0.0
-        n = int(jump.sum())
-        if n:
-            z = model.jumps.sample(rng, n)
-            margin[jump] += model.kappa * z
-            e[jump] -= z
-        if t_mid > t_burn:
-            acc += n * np.exp(-1j * np.asarray(omegas) * t_mid)
-    return 2.0 * acc / (n_blocks * t_meas) * model.zbar / (V * nu)
-
-
 def test_characteristic_function_against_an_open_loop_simulation():
     # the linearised renewal equation, its signs and its closure, against blocks driven by
     # a prescribed oscillating slip velocity.  At k0 = 0.1, V = 2, G(i w) moves from
@@ -256,8 +242,8 @@ def test_characteristic_function_against_an_open_loop_simulation():
     # 5-unit burn-in left a bias of 0.025 at the lower frequency, 40 units remove it.)
     model, V = PAPER, 2.0
     omegas = [2 * math.pi / 21.0, 6 * math.pi / 21.0]
-    simulated = _open_loop_gain(model, V, omegas, nu=0.1, n_blocks=20000, dt=2e-3, t_burn=40.0, t_meas=42.0,
-                                seed=2)
+    _, _, simulated = _simulate_blocks(model, V, n_blocks=20000, dt=2e-3, t_burn=40.0, t_meas=42.0, seed=2,
+                                       omegas=omegas, nu=0.1)
     exact = micro.characteristic_function(model, V, 1j * np.asarray(omegas))
     assert np.all(np.abs(simulated - exact) < 0.015), (simulated, exact)
 
