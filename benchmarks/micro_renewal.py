@@ -9,14 +9,19 @@ and the Fokker-Planck's stored steady stresses scored against the exact stress.
 3. ``vc``: micro.critical_velocity (method "renewal") for the paper's five k0 and the four
    (k1, k2) sets of Fig. 5: time, its error estimate, and the change against a run at
    tolerance 1e-13.
-4. ``fp``: the rows of results/micro_eps_convergence.csv (Fokker-Planck steady stress
+4. ``stress``: the supported range, k0 in {1e-4, ..., 1}, 22 V from 1e-3 to 1e4, the four
+   (k1, k2) sets, exponential, deterministic and tabulated g: finiteness, sigma and b
+   decreasing in V, points that miss tol, worst errors, and the time of the growth rate.
+5. ``waiting``: the Newton waiting time against a 40-digit root (needs ``pip install
+   mpmath``, not a dependency of the project; skipped without it).
+6. ``fp``: the rows of results/micro_eps_convergence.csv (Fokker-Planck steady stress
    against the bin eps) with their true error against the exact stress, and the measured
    order of the FP in eps (least squares of log error on log eps).
 
 Compile time is reported apart (the first call in a fresh process).  Writes
-benchmarks/results/micro_renewal_{grid,default,vc,fp}.csv.
+benchmarks/results/micro_renewal_{grid,default,vc,stress,fp}.csv.
 
-    python benchmarks/micro_renewal.py          # about a minute
+    python benchmarks/micro_renewal.py          # about two minutes
 """
 from __future__ import annotations
 
@@ -94,6 +99,53 @@ def vc_table() -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def stress_table() -> pd.DataFrame:
+    rows = []
+    V = np.geomspace(1e-3, 1e4, 22)
+    dists = {"exponential": micro.Exponential(0.1, 10.0), "deterministic": micro.Deterministic(0.1),
+             "tabulated": micro.Tabulated(pdf=lambda z: z * np.exp(-z / 0.05), support_max=2.0)}
+    for name, jumps in dists.items():
+        for k1, k2 in SETS:
+            for k0 in (1e-4, 1e-3, 1e-2, 0.1, 0.5, 1.0):
+                model = micro.Model(k0=k0, k1=k1, k2=k2, jumps=jumps)
+                t0 = time.perf_counter()
+                res = micro.steady_sliding(model, V, growth_rate=False, warn=False)
+                wall = time.perf_counter() - t0
+                rows.append(dict(jumps=name, k1=k1, k2=k2, k0=k0, n_V=V.size, wall_s=wall,
+                                 finite=bool(np.all(np.isfinite(res.sigma)) and np.all(np.isfinite(res.branching_ratio))),
+                                 sigma_decreasing=bool(np.all(np.diff(res.sigma) < 1e-12)),
+                                 b_decreasing=bool(np.all(np.diff(res.branching_ratio) < 1e-9)),
+                                 missed_tol=int(np.count_nonzero(~res.converged)),
+                                 worst_sigma_error=float(np.max(res.sigma_error)),
+                                 worst_wait_error=float(np.max(np.abs(res.wait_error)))))
+    return pd.DataFrame(rows)
+
+
+def growth_rate_time() -> float:
+    model = micro.Model(k0=0.1)
+    V = [0.3, 0.6, 0.72]
+    micro.steady_sliding(model, V)
+    return median_time(lambda: micro.steady_sliding(model, V), repeats=3) / len(V)
+
+
+def waiting_time_accuracy() -> float | None:
+    try:
+        import mpmath
+    except ImportError:
+        return None
+    from micro import _renewal_kernels as RK
+    mpmath.mp.dps = 40
+    rng = np.random.default_rng(0)
+    worst = 0.0
+    for _ in range(3000):
+        a = 10 ** rng.uniform(-5, 0)
+        D, z = 10 ** rng.uniform(-6, 1), 10 ** rng.uniform(-8, 3)
+        t = RK.waiting_time(z, D, a, 1 - a)
+        ref = mpmath.findroot(lambda s: a * s + (1 - a) * D * (1 - mpmath.exp(-s)) - z, t)
+        worst = max(worst, abs(t - float(ref)) / float(ref))
+    return worst
+
+
 def fp_table() -> tuple[pd.DataFrame, pd.DataFrame]:
     fp = pd.read_csv(RESULTS / "micro_eps_convergence.csv")
     fp = fp[(fp.regime == "steady") & fp.converged.astype(bool)].copy()
@@ -114,9 +166,14 @@ def main() -> None:
     micro.steady_sliding(micro.Model(k0=0.1), 2.0)
     print(f"compile (first call, numba cache cold or warm): {time.perf_counter() - t0:.2f} s")
     RESULTS.mkdir(exist_ok=True)
-    for name, frame in (("grid", grid_table()), ("default", default_table()), ("vc", vc_table())):
+    for name, frame in (("grid", grid_table()), ("default", default_table()), ("vc", vc_table()),
+                        ("stress", stress_table())):
         frame.to_csv(RESULTS / f"micro_renewal_{name}.csv", index=False)
         print(f"\n## {name}\n" + frame.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
+    print(f"\ngrowth rate: {1e3 * growth_rate_time():.0f} ms per unstable V (k0 = 0.1, V = 0.3, 0.6, 0.72)")
+    worst = waiting_time_accuracy()
+    print("waiting time against a 40-digit root, 3000 random (alpha, D, zeta): " +
+          ("skipped (pip install mpmath)" if worst is None else f"worst relative error {worst:.1e}"))
     fp, orders = fp_table()
     fp.to_csv(RESULTS / "micro_renewal_fp.csv", index=False)
     print("\n## fp\n" + fp.to_string(index=False, float_format=lambda x: f"{x:.6g}"))

@@ -288,7 +288,7 @@ def test_stress_every_set_and_distribution_across_k0_and_V(jumps):
     # the supported range: k0 from 1e-4 to 1, V from 1e-3 to 1e4, the four (k1, k2) sets of
     # Fig. 5.  Velocity weakening (sigma decreasing in V) and a branching ratio decreasing
     # in V (so that b(V) = 1 has one root) hold at every point; the full sweep (1584
-    # points, 46 s) is in docs/micro_renewal.md
+    # points, 23 s) is benchmarks/micro_renewal.py's stress table
     V = np.geomspace(1e-3, 1e4, 8)
     for k1, k2 in ((0.1, 0.9), (0.0, 1.0), (0.5, 0.5), (0.9, 0.1)):
         for k0 in (1e-4, 0.03, 1.0):
