@@ -542,7 +542,12 @@ def critical_velocity_renewal(model: Model, *, V_min: float = 1e-4, V_max: float
         lo, f_lo = hi, f_hi
         hi = min(hi + 1.5, lmax)
         f_hi = f(hi)
-    root = brentq(f, lo, hi, xtol=1e-14, rtol=max(rtol, 1e-15))
+    # no point in locating the root below the noise of b: where the chain cannot reach its
+    # tolerance (k1 = 0 at small k0) Brent would bisect that noise for dozens of evaluations
+    noise = max(e["error"] for e in evaluations)
+    secant = abs(f_hi - f_lo) / (hi - lo)
+    xtol = max(1e-14, 0.1 * noise / secant) if secant > 0 else 1e-14
+    root = brentq(f, lo, hi, xtol=xtol, rtol=max(rtol, 1e-15))
     Vc = math.exp(root)
     # error: the root moves by (error of b) / |db/dlog V| plus the root finder's tolerance
     h = 1e-4
