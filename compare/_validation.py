@@ -47,8 +47,8 @@ def in_range(name: str, value: object, low: float, high: float, *, low_open: boo
     return v
 
 
-def positive_int(name: str, value: object, low: int = 1) -> int:
-    """``value`` as an int; raise unless it is an integer >= ``low``."""
+def positive_int(name: str, value: object, low: int = 1, high: int | None = None) -> int:
+    """``value`` as an int; raise unless it is an integer >= ``low`` (and <= ``high``)."""
     if isinstance(value, bool):
         raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
     if isinstance(value, (int, np.integer)):
@@ -57,8 +57,9 @@ def positive_int(name: str, value: object, low: int = 1) -> int:
         v = int(value)
     else:
         raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-    if v < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+    if v < low or (high is not None and v > high):
+        bound = f">= {low}" if high is None else f"in [{low}, {high}]"
+        raise ValueError(f"{name} must be an integer {bound}, got {value!r}")
     return v
 
 

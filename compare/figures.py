@@ -1,5 +1,9 @@
-"""Figures of a report (matplotlib, Agg backend): one PNG per scenario, micro and RS on
-shared axes.  Called by :func:`compare.report` with the computed tables."""
+"""Figures of a report (matplotlib, Agg backend), micro and RS on shared axes.
+
+Conventions: a computed point is a marker (open when its run did not converge), a line
+is either exact (micro's steady branch, RS) or a fitted law, and what was not computed is
+marked as such.  Called by :func:`compare.report` with the computed tables.
+"""
 from __future__ import annotations
 
 import math
@@ -27,109 +31,231 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
-def _color(k0: float, i: int) -> str:
+def _color(k0: float, i: int = 0) -> str:
     for k, c in _COLORS.items():
         if math.isclose(k, k0, rel_tol=1e-9):
             return c
     return f"C{5 + i % 5}"
 
 
-def bifurcation(t: dict[str, pd.DataFrame], Dc: float, path: Path) -> Path:
-    """Figs. 4 and 8: micro (left) and RS with the fitted law and D_c (right), shared axes;
-    micro points repeated as markers on the RS panel."""
-    pts = t["micro_points"]
-    pts = pts[(pts.role == "diagram") & pts.regime.isin(["steady", "stick-slip"])]
+def _converged(frame: pd.DataFrame) -> np.ndarray:
+    if "converged" not in frame:
+        return np.ones(len(frame), bool)
+    return frame.converged.fillna(False).astype(bool).to_numpy()
+
+
+def bifurcation(t: dict[str, pd.DataFrame], Dc: float, fp_k0, path: Path) -> Path:
+    """Figs. 4 and 8: micro (left: exact steady branch, FP stick-slip points) and RS with
+    the fitted law and D_c (right), shared axes."""
+    branch = t["micro_branch"]
+    branch = branch[branch.role == "branch"]
+    pts = t.get("micro_points", pd.DataFrame(columns=["k0", "V", "regime", "sigma_max", "sigma_min", "method"]))
     rs = t["rs_bifurcation"]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), sharex=True, sharey=True)
-    for i, (k0, grp) in enumerate(rs.groupby("k0", sort=False)):
-        c = _color(k0, i)
-        for ax in axes[1:]:
-            ax.semilogx(grp.V, grp.sigma_max, "-", color=c, lw=1.2, label=f"k0 = {k0:g}")
-            ax.semilogx(grp.V, grp.sigma_min, "-", color=c, lw=1.2)
-    for i, (k0, grp) in enumerate(pts.groupby("k0", sort=False)):
+    band = t.get("rs_unstable_band")
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharex=True, sharey=True)
+    ax = axes[0]
+    for i, (k0, grp) in enumerate(branch.groupby("k0", sort=False)):
         c = _color(k0, i)
         grp = grp.sort_values("V")
-        axes[0].semilogx(grp.V, grp.sigma_max, "o-", color=c, ms=4, label=f"k0 = {k0:g}")
-        axes[0].semilogx(grp.V, grp.sigma_min, "s--", color=c, ms=4)
-        axes[1].semilogx(grp.V, grp.sigma_max, "o", color=c, ms=4, mfc="none")
-        axes[1].semilogx(grp.V, grp.sigma_min, "s", color=c, ms=4, mfc="none")
-    axes[0].set_title("micro model (Fig. 4): sigma_max (o), sigma_min (s)")
-    axes[1].set_title(f"RS, fitted Eq. (10), D_c = {Dc:.3g} (Fig. 8); open: micro")
+        st, un = grp[grp.stable.astype(bool)], grp[~grp.stable.astype(bool)]
+        ax.semilogx(st.V, st.sigma, "-", color=c, lw=1.3, label=f"k0 = {k0:g}")
+        ax.semilogx(un.V, un.sigma, ":", color=c, lw=1.0)
+        vc = float(grp.Vc.iloc[0])
+        if vc > 0:
+            y = float(np.interp(math.log(vc), np.log(grp.V), grp.sigma))
+            ax.plot([vc], [y], "|", color=c, ms=14, mew=2)
+            if not any(math.isclose(k0, k, rel_tol=1e-9) for k in fp_k0):
+                ax.annotate("stick-slip not computed", (vc, y), xytext=(0, 12), textcoords="offset points",
+                            ha="center", va="bottom", rotation=90, fontsize=6, color=c)
+        p = pts[np.isclose(pts.k0, k0) & (pts.regime == "stick-slip")] if len(pts) else pts
+        if len(p):
+            ok = _converged(p)
+            for sel, fill in ((ok, c), (~ok, "none")):
+                ax.semilogx(p.V[sel], p.sigma_max[sel], "o", color=c, mfc=fill, ms=5)
+                ax.semilogx(p.V[sel], p.sigma_min[sel], "s", color=c, mfc=fill, ms=5)
+    ax.set_title("micro (Fig. 4): exact steady branch (dotted: unstable), | = V^c;\n"
+                 "FP stick-slip sigma_max (o), sigma_min (s); open: not converged", fontsize=9)
+    ax = axes[1]
+    for i, (k0, grp) in enumerate(rs.groupby("k0", sort=False)):
+        c = _color(k0, i)
+        grp = grp.sort_values("V")
+        ax.semilogx(grp.V, grp.sigma_max, "-", color=c, lw=1.2, label=f"k0 = {k0:g}")
+        ax.semilogx(grp.V, grp.sigma_min, "-", color=c, lw=1.2)
+        if band is not None:
+            b = band[np.isclose(band.k0, k0)]
+            if len(b):
+                for V, mark in ((b.Vc.iloc[0], "|"), (b.V_lower.iloc[0], "x")):
+                    if math.isfinite(V) and V > 0:
+                        y = float(np.interp(math.log(V), np.log(grp.V), grp.sigma_mean))
+                        ax.plot([V], [y], mark, color=c, ms=10, mew=2)
+        p = pts[np.isclose(pts.k0, k0) & (pts.regime == "stick-slip")] if len(pts) else pts
+        if len(p):
+            ax.semilogx(p.V, p.sigma_max, "o", color=c, mfc="none", ms=5)
+            ax.semilogx(p.V, p.sigma_min, "s", color=c, mfc="none", ms=5)
+    ax.set_title(f"RS, fitted Eq. (10), D_c = {Dc:.3g} (Fig. 8): | = V^c, x = V_- (steady again below);\n"
+                 "open: micro's stick-slip points", fontsize=9)
     for ax in axes:
         ax.set_xlabel("driving velocity V")
+        ax.legend(fontsize=7, loc="lower left")
+    axes[0].set_ylabel("sigma_max, sigma_min (steady: sigma)")
+    return _save(fig, path)
+
+
+def steady_fit(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
+    """Fig. 6 (micro's velocity weakening, exact, log-log) and the Eq. (10) residual."""
+    b = t["micro_branch"]
+    chk = t["steady_fit_checks"].set_index("k0")
+    res = t["steady_fit_residuals"]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.3))
+    for i, (k0, grp) in enumerate(b[b.stable.astype(bool)].groupby("k0", sort=False)):
+        if k0 not in chk.index:
+            continue
+        c = _color(k0, i)
+        grp = grp.sort_values("V")
+        axes[0].loglog(grp.V, grp.sigma - chk.sigma_inf_exact[k0], "-", color=c, label=f"k0 = {k0:g}")
+        axes[0].loglog(grp.V, values["A"] / (grp.V + values["B"]) + chk.mu_inf[k0] - chk.sigma_inf_exact[k0],
+                       "--", color=c, lw=0.8)
+        r = res[np.isclose(res.k0, k0)].sort_values("V")
+        axes[1].semilogx(r.V, r.residual, ".-", color=c, ms=3, lw=0.8, label=f"k0 = {k0:g}")
+    V = np.geomspace(b.V.min(), b.V.max(), 50)
+    axes[0].loglog(V, chk.tail_exact.iloc[0] / V, "k:", lw=1, label="exact tail C/V")
+    axes[0].set_ylabel("sigma(V) - sigma(V→∞)")
+    axes[0].set_title("Fig. 6: micro's exact steady branch (solid), Eq. (10) fit (dashed)", fontsize=9)
+    axes[1].axhline(0, color="k", lw=0.6)
+    axes[1].set_ylabel("micro - Eq. (10)")
+    axes[1].set_title(f"Eq. (10) residual: A = {values['A']:.4g}, B = {values['B']:.4g}, "
+                      f"rms {values['steady_rms']:.2g}", fontsize=9)
+    for ax in axes:
+        ax.set_xlabel("V")
         ax.legend(fontsize=7)
-    axes[0].set_ylabel("sigma_max, sigma_min")
     return _save(fig, path)
 
 
 def dc_profile(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
     prof = t["dc_profile"]
-    fig, ax = plt.subplots(figsize=(5.5, 4))
-    ax.loglog(prof.Dc, prof.rms, "o-", ms=3)
-    ax.axvline(values["Dc"], color="k", lw=0.8, label=f"fit D_c = {values['Dc']:.3g} ± {values['Dc_err']:.2g}")
-    ax.axvspan(*values["Dc_profile"], color="k", alpha=0.1)
-    ax.axvline(0.06, color="r", ls=":", label="paper D_c = 0.06")
+    fig, ax = plt.subplots(figsize=(6.5, 4.3))
+    ax.loglog(prof.Dc, prof.rms, "o-", ms=3, label="rms(sigma_RS - sigma_micro) on the scan grid")
+    sw = t["dc_points"].Dc_switch.to_numpy(float)
+    for j, s in enumerate(sw[np.isfinite(sw) & (sw > 0)]):
+        ax.axvline(s, color="0.6", ls=":", lw=0.7, label="regime switch of a point" if j == 0 else None)
+    Dc = values["Dc"]
+    lo, hi = values["Dc_profile"]
+    if values.get("Dc_one_sided"):
+        bound = "<=" if values["Dc_one_sided"] == "upper" else ">="
+        lab = f"(a) D_c = {Dc:.3g}: on a switch, one-sided D_c {bound} {values['Dc_switch']:.3g}"
+    else:
+        lab = f"(a) D_c = {Dc:.3g} ± {values['Dc_err']:.2g}"
+    ax.axvline(Dc, color="k", lw=1, label=lab)
+    ax.axvspan(lo, hi, color="k", alpha=0.1, label=f"profile interval [{lo:.3g}, {hi:.3g}]")
+    b_lo, b_hi = values["Dc_vc_range"]
+    ax.axvline(values["Dc_vc"], color="C3", lw=1, label=f"(b) V^c matching: {values['Dc_vc']:.3g}")
+    ax.axvspan(b_lo, b_hi, color="C3", alpha=0.1, label=f"(b) per-k0 range [{b_lo:.3g}, {b_hi:.3g}]")
+    ax.axvline(0.06, color="C2", ls="--", lw=0.8, label="paper D_c = 0.06")
     ax.set_xlabel("D_c")
-    ax.set_ylabel("rms(sigma_RS - sigma_micro)")
-    ax.legend(fontsize=8)
+    ax.set_ylabel("rms residual of sigma_max, sigma_min")
+    ax.legend(fontsize=6, loc="upper right")
     return _save(fig, path)
 
 
-def hopf(t: dict[str, pd.DataFrame], path: Path) -> Path:
-    pts, fit = t["hopf_points"], t["hopf_fit"]
-    fig, ax = plt.subplots(figsize=(6, 4.5))
-    for i, (name, grp) in enumerate(pts.groupby("model")):
-        grp = grp[(grp.regime == "stick-slip") & (grp.amplitude > 0)]
-        gap = grp.Vc - grp.V
-        ax.loglog(gap, grp.amplitude, "o" if name == "micro" else "s", color=f"C{i}", label=name)
-        for _, f in fit[fit.model == name].iterrows():
-            x = np.geomspace(max(gap.min(), 1e-12) * 0.8, gap.max() * 1.2, 50)
-            if f.Vc_fitted:  # the fit is in V; plot against the bisection gap
-                Vc0 = grp.Vc.iloc[0]
-                V = Vc0 - x
-                y = f.prefactor * np.clip(f.Vc - V, 1e-300, None) ** f.exponent
-                style = ":"
-            else:
-                y = f.prefactor * x ** f.exponent
-                style = "-"
-            ax.loglog(x, y, style, color=f"C{i}", lw=1,
-                      label=f"{name} ({f.Vc_mode}): beta = {f.exponent:.2f} ± {f.exponent_err:.2f}")
-    ax.set_xlabel("Vc - V")
-    ax.set_ylabel("sigma_max - sigma_min")
-    ax.set_title(f"Hopf scaling at k0 = {pts.k0.iloc[0]:g}")
+def critical_velocity(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
+    """V^c(k0): micro exact against RS with each D_c (and the paper's law)."""
+    cur, crit = t["vc_curves"], t["critical_velocity"]
+    fig, ax = plt.subplots(figsize=(6.5, 4.8))
+    ax.loglog(cur.k0, cur.Vc_micro, "o", color="k", ms=3, label="micro, exact")
+    ax.loglog(crit.k0, crit.Vc_micro, "o", color="k", ms=7, mfc="none")
+    ax.loglog(crit.k0, crit.Vc_micro_small_k0, "k:", lw=0.8, label="micro small-k0 asymptote")
+    if "Dc" in values:
+        ax.loglog(cur.k0, cur.Vc_rs, "-", color="C0", label=f"RS, D_c (a) = {values['Dc']:.3g} (extrema)")
+    else:
+        ax.loglog(cur.k0, cur.Vc_rs, "-", color="C0", label=f"RS, D_c = {crit.Dc.iloc[0]:.3g} (given)")
+    ax.loglog(cur.k0, cur.Vc_rs_dc_vc, "--", color="C3", label=f"RS, D_c (b) = {values['Dc_vc']:.3g} (V^c match)")
+    ax.loglog(cur.k0, cur.Vc_rs_paper, ":", color="C2", label="RS, paper's A, B, D_c")
+    ax.set_xlabel("k0")
+    ax.set_ylabel("V^c (stick-slip below, steady above)")
+    ax.set_title("Critical velocity: micro (exact) and RS with each D_c", fontsize=9)
     ax.legend(fontsize=7)
     return _save(fig, path)
 
 
-def phase(t: dict[str, pd.DataFrame], Dc: float, path: Path) -> Path:
+def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
+    """The transition: micro's growth rate against d, and both models' amplitude against
+    d = (V^c - V)/V^c (each with its own exact V^c)."""
+    pts, fit, spec = t["hopf_points"], t["hopf_fit"], t["micro_spectrum"]
+    fig, axes = plt.subplots(1, 2, figsize=(11.5, 4.5))
+    ax = axes[0]
+    sp = spec[np.isfinite(spec.growth_rate)]
+    ax.loglog(sp.d, sp.growth_rate, "o-", ms=3, color="C1", label="micro: growth rate of the unstable mode (real)")
+    ax.set_xlabel("d = (V^c - V) / V^c")
+    ax.set_ylabel("growth rate")
+    ax.set_title(f"micro's spectrum below V^c (k0 = {pts.k0.iloc[0]:g}); diverges at V^c", fontsize=9)
+    ax.legend(fontsize=7)
+    ax = axes[1]
+    styles = {("micro", "FP"): ("o", "C1"), ("micro", "N-block"): ("D", "C3"), ("RS", "CVODE"): ("s", "C0")}
+    for (name, method, res), grp in pts.groupby(["model", "method", "resolution"], dropna=False, sort=False):
+        grp = grp[(grp.regime == "stick-slip") & (grp.amplitude > 0)].sort_values("d")
+        if not len(grp):
+            continue
+        mark, c = styles.get((name, method), ("^", "C5"))
+        coarse = method == "FP" and res == pts[pts.method == "FP"].resolution.max()
+        small_N = method == "N-block" and res == pts[pts.method == "N-block"].resolution.min()
+        mfc = "none" if (coarse or small_N) else c
+        lab = f"{name} {method}" + ("" if not math.isfinite(res) else (f" eps={res:g}" if method == "FP" else f" N={res:.0f}"))
+        yerr = grp.amplitude_stderr if method == "N-block" and "amplitude_stderr" in grp else None
+        ax.errorbar(grp.d, grp.amplitude, yerr=yerr, fmt=mark, color=c, mfc=mfc, ms=5, label=lab)
+        f = fit[(fit.model == name) & (fit.method == method) & (fit.resolution.fillna(-1) == (res if math.isfinite(res) else -1))]
+        if len(f) and not (coarse or small_N):
+            f = f.iloc[0]
+            d = np.geomspace(grp.d.min() * 0.7, grp.d.max() * 1.3, 50)
+            ax.loglog(d, f.prefactor * (f.Vc * d) ** f.exponent, "-", color=c, lw=0.8,
+                      label=f"  fit: beta = {f.exponent:.2f} ± {f.exponent_err:.2f}")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("d = (V^c - V) / V^c (each model's own exact V^c)")
+    ax.set_ylabel("sigma_max - sigma_min")
+    ax.set_title("Amplitude near V^c (open: coarser bin / smaller N)", fontsize=9)
+    ax.legend(fontsize=6)
+    return _save(fig, path)
+
+
+def phase(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
     rs, mic, laws = t["phase_rs"], t["phase_micro"], t["phase_laws"]
     sets = list(laws[["k1", "k2"]].itertuples(index=False, name=None))
     n = max(len(sets), 1)
-    fig, axes = plt.subplots(1, n, figsize=(3.4 * n + 0.6, 4), sharex=True, sharey=True, squeeze=False)
+    fig, axes = plt.subplots(1, n, figsize=(3.6 * n + 0.6, 4.2), sharex=True, sharey=True, squeeze=False)
     for ax, (k1, k2) in zip(axes[0], sets):
         r = rs[np.isclose(rs.k1, k1) & np.isclose(rs.k2, k2)]
-        ax.loglog(r.k0, r.Vc, "-", color="C0", label="RS Vc")
-        ax.loglog(r.k0, r.asymptote, ":", color="C0", lw=0.8, label="A/(k0 D_c)")
-        ax.axvline(r.k0_max_rs.iloc[0], color="C0", ls="--", lw=0.8, label="RS k0_max")
-        ax.axvline(k2, color="C1", ls="--", lw=0.8, label="micro limit k0 = k2")
-        m = mic[np.isclose(mic.k1, k1) & np.isclose(mic.k2, k2) & (mic.status == "converged")]
-        if len(m):
-            ax.errorbar(m.k0, m.Vc, yerr=[m.Vc - m.V_low, m.V_high - m.Vc], fmt="o", color="C1", label="micro Vc")
+        ax.loglog(r.k0, r.Vc, "-", color="C0", label="RS, D_c (a)")
+        ax.loglog(r.k0, r.Vc_dc_vc, "--", color="C3", label="RS, D_c (b)")
+        ax.axvline(r.k0_max_rs.iloc[0], color="C0", ls="-.", lw=0.7, label="RS k0_max (a)")
+        m = mic[np.isclose(mic.k1, k1) & np.isclose(mic.k2, k2) & (mic.Vc > 0)]
+        ax.loglog(m.k0, m.Vc, "o", color="k", ms=3, label="micro, exact")
+        ax.loglog(m.k0, m.asymptote, "k:", lw=0.8, label="micro 1/k0 asymptote")
+        ax.axvline(k2, color="k", ls="--", lw=0.7, label="micro: V^c → 0 at k0 = k2")
         ax.set_title(f"k1 = {k1:g}, k2 = {k2:g}", fontsize=9)
         ax.set_xlabel("k0")
-    axes[0][0].set_ylabel("Vc (stick-slip below, steady above)")
-    axes[0][0].set_ylim(1e-3, 1e4)
+    axes[0][0].set_ylabel("V^c (stick-slip below, steady above)")
+    axes[0][0].set_ylim(1e-3, 1e5)
     axes[0][0].legend(fontsize=6)
-    fig.suptitle(f"Phase diagram (Fig. 5), D_c = {Dc:.3g}", fontsize=10)
+    fig.suptitle("Phase diagram (Fig. 5)", fontsize=10)
     return _save(fig, path)
 
 
 def shs(t: dict[str, pd.DataFrame], path: Path) -> Path:
     pts, fit = t["shs_points"], t["shs_fit"]
+    trace = t.get("shs_trace")
     models = list(dict.fromkeys(pts.model))
     own = {"micro": "exponential", "RS Eq. (11)": "algebraic", "classical RS Eq. (7)": "logarithmic"}
-    fig, axes = plt.subplots(1, len(models), figsize=(4 * len(models), 4), sharex=True, squeeze=False)
-    for ax, name in zip(axes[0], models):
+    extra = 1 if trace is not None else 0
+    fig, axes = plt.subplots(1, len(models) + extra, figsize=(4 * (len(models) + extra), 4), squeeze=False)
+    if trace is not None:
+        ax = axes[0][0]
+        sel = trace[(trace.t > -0.3 * trace.hold_time.iloc[0])]
+        ax.plot(sel.t, sel.sigma, "-", color="k", lw=0.8)
+        ax.axvline(0, color="C3", lw=0.7, ls=":")
+        ax.set_xlabel("t (0: the drive restarts)")
+        ax.set_ylabel("sigma")
+        ax.set_title(f"Fig. 7 (left): micro, hold {trace.hold_time.iloc[0]:g}, V = {trace.V.iloc[0]:g}", fontsize=9)
+    for ax, name in zip(axes[0][extra:], models):
         grp = pts[pts.model == name]
         ax.semilogx(grp.hold_time, grp.delta_sigma_max, "o", color="k", label=name)
         x = np.geomspace(grp.hold_time.min() * 0.7, grp.hold_time.max() * 1.5, 100)
@@ -144,8 +270,37 @@ def shs(t: dict[str, pd.DataFrame], path: Path) -> Path:
         ax.set_title(name, fontsize=9)
         ax.set_xlabel("hold time")
         ax.legend(fontsize=6)
-    axes[0][0].set_ylabel("peak - steady stress")
+    axes[0][extra].set_ylabel("peak - steady stress")
     fig.suptitle("Slide-hold-slide (Fig. 7): growth laws (solid: the model's expected law)", fontsize=10)
+    return _save(fig, path)
+
+
+def fig3(t: dict[str, pd.DataFrame], path: Path) -> Path:
+    d = t["fig3_traces"]
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    for V, g in d.groupby("V"):
+        ax.plot(g.t * V, g.sigma, lw=0.8, label=f"V = {V:g}")
+    ax.set_xlabel("drive displacement w = V t")
+    ax.set_ylabel("sigma")
+    ax.set_title(f"Fig. 3: micro, k0 = {d.k0.iloc[0]:g}", fontsize=9)
+    ax.legend(fontsize=7)
+    return _save(fig, path)
+
+
+def fig10(t: dict[str, pd.DataFrame], path: Path) -> Path:
+    d = t["fig10_eps"]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for i, (k0, g) in enumerate(d.groupby("k0", sort=False)):
+        g = g.sort_values("eps")
+        ok = _converged(g)
+        c = _color(k0, i)
+        ax.loglog(g.eps, np.abs(g.error), "-", color=c, lw=0.7)
+        ax.loglog(g.eps[ok], np.abs(g.error[ok]), "o", color=c, label=f"k0 = {k0:g}, V = {g.V.iloc[0]:.3g}")
+        ax.loglog(g.eps[~ok], np.abs(g.error[~ok]), "o", color=c, mfc="none")
+    ax.set_xlabel("bin eps")
+    ax.set_ylabel("|sigma_FP - sigma_exact|")
+    ax.set_title("Fig. 10: the FP's stress against the bin, V = 1.5 V^c (exact: direct method)", fontsize=9)
+    ax.legend(fontsize=7)
     return _save(fig, path)
 
 
@@ -154,13 +309,21 @@ def draw(study, out: Path) -> dict[str, Path]:
     t, v = study.tables, study.values
     figs: dict[str, Path] = {}
     if "rs_bifurcation" in t:
-        figs["bifurcation"] = bifurcation(t, study.Dc, out / "bifurcation.png")
+        figs["bifurcation"] = bifurcation(t, study.Dc, study.s.fp_k0, out / "bifurcation.png")
+    if "steady_fit_checks" in t:
+        figs["steady_fit"] = steady_fit(t, v, out / "steady_fit.png")
     if "dc_profile" in t:
         figs["dc_profile"] = dc_profile(t, v, out / "dc_profile.png")
+    if "vc_curves" in t:
+        figs["critical_velocity"] = critical_velocity(t, v, out / "critical_velocity.png")
     if "hopf_points" in t:
-        figs["hopf"] = hopf(t, out / "hopf.png")
+        figs["hopf"] = hopf(t, v, out / "hopf.png")
     if "phase_rs" in t and len(t["phase_laws"]):
-        figs["phase"] = phase(t, study.Dc, out / "phase.png")
+        figs["phase"] = phase(t, v, out / "phase.png")
     if "shs_points" in t:
         figs["shs"] = shs(t, out / "shs.png")
+    if "fig3_traces" in t:
+        figs["fig3"] = fig3(t, out / "fig3.png")
+    if "fig10_eps" in t:
+        figs["fig10"] = fig10(t, out / "fig10.png")
     return figs

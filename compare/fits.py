@@ -16,7 +16,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from typing import Any, Callable
 
 import numpy as np
 import pandas as pd
@@ -24,7 +24,7 @@ from scipy.optimize import brentq, curve_fit, least_squares, minimize_scalar
 
 import rsf
 
-from ._validation import choice, in_range, positive
+from ._validation import choice, positive
 
 __all__ = [
     "SteadyLawFit",
@@ -33,6 +33,10 @@ __all__ = [
     "fit_dc",
     "rs_diagram",
     "dc_from_critical_velocity",
+    "DcCriticalFit",
+    "fit_dc_critical",
+    "steady_law_checks",
+    "classify_transition",
     "PowerLawFit",
     "fit_power_law",
     "GrowthFit",
@@ -263,6 +267,11 @@ class DcFit:
     ----------
     Dc : float
         Least-squares optimum of the stress residual over the points.
+    one_sided, switch : str, float
+        The residual jumps where the RS regime of a point switches (at
+        :math:`k_0 D_c = W(V)`).  When the optimum sits on such a switch (within 1 %), the
+        data bound D_c from one side only: ``one_sided`` is ``'upper'`` (D_c <= switch) or
+        ``'lower'``, and ``switch`` is that D_c; otherwise ``''`` and NaN.
     Dc_err : float
         Standard error: half the width of the bootstrap 16-84 % interval (resampling the
         points); ``Dc_profile`` is the profile interval where
@@ -287,12 +296,15 @@ class DcFit:
     n_points: int
     regime_agreement: float
     bootstrap: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
+    one_sided: str = ""
+    switch: float = math.nan
 
     def to_frame(self) -> pd.DataFrame:
         return pd.DataFrame([{"Dc": self.Dc, "Dc_err": self.Dc_err, "Dc_profile_low": self.Dc_profile[0],
                               "Dc_profile_high": self.Dc_profile[1], "Dc_bootstrap_16": self.Dc_bootstrap[0],
                               "Dc_bootstrap_84": self.Dc_bootstrap[1], "rms": self.rms,
-                              "n_points": self.n_points, "regime_agreement": self.regime_agreement}])
+                              "n_points": self.n_points, "regime_agreement": self.regime_agreement,
+                              "one_sided": self.one_sided, "switch": self.switch}])
 
 
 def _diagram_points(frame: pd.DataFrame, converged_only: bool) -> pd.DataFrame:
@@ -406,9 +418,20 @@ def fit_dc(frame: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateLaw], 
     per_k0 = per_k0.drop(columns="sq")
     agree = float(np.mean(out.regime_rs.to_numpy() == out.regime_micro.to_numpy()))
     profile = pd.DataFrame({"Dc": grid, "rss": rss_grid, "rms": np.sqrt(rss_grid / (2 * n))})
+    # regime switches: RS is unstable at (k0, V) for k0 Dc < W(V)
+    switches = np.array([float(law_for(k).weakening(np.array([v]))[0]) / k
+                         for k, v in zip(pts.k0.to_numpy(float), pts.V.to_numpy(float))])
+    out["Dc_switch"] = switches
+    one_sided, switch = "", math.nan
+    near = switches[np.isfinite(switches) & (switches > 0)]
+    if near.size:
+        j = int(np.argmin(np.abs(np.log(near / Dc))))
+        if abs(math.log(near[j] / Dc)) < 0.01:
+            switch = float(near[j])
+            one_sided = "upper" if Dc <= switch else "lower"
     return DcFit(Dc=Dc, Dc_err=Dc_err, Dc_profile=profile_interval, Dc_bootstrap=(q16, q84),
                  rms=math.sqrt(rss_min / (2 * n)), rms_per_k0=per_k0, profile=profile, points=out,
-                 n_points=n, regime_agreement=agree, bootstrap=boot)
+                 n_points=n, regime_agreement=agree, bootstrap=boot, one_sided=one_sided, switch=switch)
 
 
 def _parabolic_min(x: np.ndarray, y: np.ndarray) -> float:
@@ -423,6 +446,179 @@ def _parabolic_min(x: np.ndarray, y: np.ndarray) -> float:
     if a <= 0:
         return float(x1)
     return float(np.clip(-b / (2 * a), x0, x2))
+
+
+# ============================================================================ D_c from V^c
+@dataclass
+class DcCriticalFit:
+    r"""D_c from matching the RS critical velocity to micro's, over several k0.
+
+    Attributes
+    ----------
+    Dc : float
+        Least squares of :math:`\ln V^c_{RS}(k_0; D_c) - \ln V^c_{micro}(k_0)` over the k0.
+    Dc_err : float
+        Its standard error (Gauss-Newton, residual variance); it says how well one D_c
+        fits every k0 only together with ``Dc_range``.
+    Dc_range : (float, float)
+        The smallest and largest per-k0 D_c (each reproduces its k0 exactly).
+    rms_log : float
+        Root-mean-square of the log residual at the optimum (0.01 = 1 % in V^c).
+    per_k0 : DataFrame
+        ``k0, Vc_micro, W_law, Dc_law`` (k0 D_c = W(V^c) of the fitted law),
+        ``W_exact, Dc_exact_slope`` (with micro's own slope -V dsigma/dV at V^c),
+        ``Vc_rs`` (at the optimum) and ``rel_diff``.
+    """
+
+    Dc: float
+    Dc_err: float
+    Dc_range: tuple[float, float]
+    rms_log: float
+    per_k0: pd.DataFrame
+
+    def to_frame(self) -> pd.DataFrame:
+        return pd.DataFrame([{"Dc": self.Dc, "Dc_err": self.Dc_err, "Dc_min": self.Dc_range[0],
+                              "Dc_max": self.Dc_range[1], "rms_log": self.rms_log}])
+
+
+def fit_dc_critical(k0, Vc, law_for: Callable[[float], rsf.SteadyStateLaw], *,
+                    slopes: dict[float, float] | None = None,
+                    bounds: tuple[float, float] = (1e-3, 1.0)) -> DcCriticalFit:
+    r"""D_c such that the RS critical velocity matches micro's ``Vc`` at each ``k0``.
+
+    Per k0 the match is exact: :math:`k_0 D_c = W(V^c) = -V\,\mu_{ss}'(V)|_{V^c}` with
+    the law's weakening (``Dc_law``) and, given ``slopes`` (k0 -> micro's own W at its
+    V^c), with micro's (``Dc_exact_slope``): the two differ by the error of the law's
+    slope.  One D_c for every k0 is the least-squares fit of the log critical velocities.
+    """
+    k0 = np.asarray(k0, dtype=float)
+    Vc = np.asarray(Vc, dtype=float)
+    if k0.shape != Vc.shape or k0.ndim != 1 or k0.size < 1:
+        raise ValueError("k0 and Vc must be 1-D arrays of equal, non-zero length")
+    if not (np.all(np.isfinite(Vc)) and np.all(Vc > 0) and np.all(k0 > 0)):
+        raise ValueError(f"k0 and Vc must be finite and > 0, got k0 = {k0!r}, Vc = {Vc!r}")
+    lo, hi = positive("bounds[0]", bounds[0]), positive("bounds[1]", bounds[1])
+    slopes = slopes or {}
+    rows = []
+    for k, v in zip(k0, Vc):
+        W = float(law_for(k).weakening(np.array([v]))[0])
+        We = slopes.get(float(k), math.nan)
+        rows.append({"k0": float(k), "Vc_micro": float(v), "W_law": W, "Dc_law": W / k,
+                     "W_exact": We, "Dc_exact_slope": We / k})
+    per = pd.DataFrame(rows)
+
+    def vc_rs(D: float) -> np.ndarray:
+        return np.array([rsf.critical_velocity(law_for(k), k, D).Vc for k in k0])
+
+    def resid(g: float) -> np.ndarray:
+        r = np.log(vc_rs(math.exp(g))) - np.log(Vc)
+        return np.where(np.isfinite(r), r, 10.0)
+
+    opt = minimize_scalar(lambda g: float(resid(g) @ resid(g)), bounds=(math.log(lo), math.log(hi)),
+                          method="bounded", options={"xatol": 1e-9})
+    g = float(opt.x)
+    Dc = math.exp(g)
+    r = resid(g)
+    h = 1e-4
+    J = (resid(g + h) - resid(g - h)) / (2 * h)
+    dof = max(k0.size - 1, 1)
+    s2 = float(r @ r) / dof
+    Dc_err = Dc * math.sqrt(s2 / float(J @ J)) if k0.size > 1 and float(J @ J) > 0 else math.nan
+    per["Vc_rs"] = vc_rs(Dc)
+    per["rel_diff"] = per.Vc_rs / per.Vc_micro - 1.0
+    return DcCriticalFit(Dc=Dc, Dc_err=Dc_err, Dc_range=(float(per.Dc_law.min()), float(per.Dc_law.max())),
+                         rms_log=float(math.sqrt(np.mean(r * r))), per_k0=per)
+
+
+def steady_law_checks(fit: SteadyLawFit, sigma_inf: dict[float, float], tail: dict[float, float]) -> pd.DataFrame:
+    r"""Where Eq. (10) departs from an exact steady branch, per k0.
+
+    ``sigma_inf`` and ``tail`` hold the exact large-V behaviour of the branch,
+    :math:`\sigma \to \sigma_\infty + C/V` (micro: :func:`micro.sigma_fast_limit`); Eq. (10)
+    has :math:`\mu_\infty + A/V`.  Returns ``k0, mu_inf, sigma_inf_exact, offset_error``
+    (:math:`\mu_\infty - \sigma_\infty`), ``A, tail_exact, tail_ratio`` (A / C),
+    ``max_abs_residual, V_at_max, rms`` and ``tail_residual`` (the residual at the largest V
+    relative to the exact :math:`\sigma - \sigma_\infty` there).
+    """
+    res = fit.residuals
+    rows = []
+    for _, off in fit.offsets.iterrows():
+        k0 = float(off.k0)
+        r = res[np.isclose(res.k0, k0, rtol=1e-12, atol=0)]
+        i = int(np.argmax(np.abs(r.residual.to_numpy())))
+        last = r.iloc[int(np.argmax(r.V.to_numpy()))]
+        si = sigma_inf.get(k0, math.nan)
+        rows.append({"k0": k0, "mu_inf": float(off.mu_inf), "sigma_inf_exact": si,
+                     "offset_error": float(off.mu_inf) - si, "A": fit.A, "tail_exact": tail.get(k0, math.nan),
+                     "tail_ratio": fit.A / tail.get(k0, math.nan),
+                     "max_abs_residual": float(abs(r.residual.iloc[i])), "V_at_max": float(r.V.iloc[i]),
+                     "rms": float(np.sqrt(np.mean(r.residual.to_numpy() ** 2))),
+                     "tail_residual": float(last.residual / (last.sigma_mean - si)) if math.isfinite(si) else math.nan,
+                     "V_max": float(last.V)})
+    return pd.DataFrame(rows)
+
+
+# ============================================================================ transition
+def classify_transition(spectrum: pd.DataFrame, amplitude_fits: pd.DataFrame, points: pd.DataFrame) -> dict:
+    r"""What kind of bifurcation micro's loss of stability at V^c is, from the evidence.
+
+    A Hopf bifurcation has a complex pair of eigenvalues crossing the imaginary axis at a
+    finite frequency: the growth rate vanishes at V^c and the period of the born cycle stays
+    finite, its amplitude growing like :math:`(V^c - V)^{1/2}`.  ``spectrum`` holds the growth
+    rate of micro's unstable (real) mode against d = (V^c - V)/V^c; ``amplitude_fits`` the
+    fitted amplitude laws; ``points`` the N-block periods.  Returns the numbers and a
+    one-paragraph verdict (``text``).
+    """
+    out: dict[str, Any] = {}
+    sp = spectrum[np.isfinite(spectrum.growth_rate)].sort_values("d")
+    if len(sp) >= 2:
+        near, far = sp.iloc[0], sp.iloc[int(np.argmin(np.abs(sp.d.to_numpy() - 0.5)))]
+        out.update(d_near=float(near.d), growth_near=float(near.growth_rate), d_far=float(far.d),
+                   growth_far=float(far.growth_rate))
+        out["growth_diverges"] = bool(near.growth_rate > 10 * far.growth_rate)
+    micro_fits = amplitude_fits[(amplitude_fits.model == "micro")] if len(amplitude_fits) else amplitude_fits
+    nb = micro_fits[micro_fits.method == "N-block"] if len(micro_fits) else micro_fits
+    if len(nb):
+        best = nb.sort_values("resolution").iloc[-1]
+        out.update(beta=float(best.exponent), beta_err=float(best.exponent_err),
+                   beta_spread=float(nb.exponent.max() - nb.exponent.min()) if len(nb) > 1 else math.nan,
+                   beta_N=float(best.resolution))
+    per = points[(points.model == "micro") & (points.method == "N-block") & (points.regime == "stick-slip")]
+    if len(per) >= 3 and "period" in per:
+        per = per[per.resolution == per.resolution.max()]
+        per = per[np.isfinite(per.period) & (per.period > 0)]
+        if len(per) >= 3:
+            slope = np.polyfit(np.log(per.d.to_numpy(float)), np.log(per.period.to_numpy(float)), 1)[0]
+            out["period_exponent"] = float(slope)
+            out["period_near"] = float(per.sort_values("d").period.iloc[0])
+            out["d_period_near"] = float(per.sort_values("d").d.iloc[0])
+    parts = []
+    if "growth_diverges" in out:
+        if out["growth_diverges"]:
+            parts.append(f"the unstable mode of steady sliding is real and its growth rate rises from "
+                         f"{out['growth_far']:.3g} at d = {out['d_far']:.2g} to {out['growth_near']:.3g} at "
+                         f"d = {out['d_near']:.2g}: it diverges at V^c instead of vanishing, so the eigenvalue "
+                         f"enters from infinity (the branching ratio reaches 1) and no complex pair crosses the "
+                         f"imaginary axis")
+        else:
+            parts.append(f"the growth rate of the unstable mode falls to {out['growth_near']:.3g} at "
+                         f"d = {out['d_near']:.2g}, as at a local bifurcation")
+    if "beta" in out:
+        parts.append(f"the N-block amplitude vanishes continuously, as d^beta with beta = {out['beta']:.2f} "
+                     f"± {out['beta_err']:.2f} (N = {out['beta_N']:.0f}"
+                     + (f"; {out['beta_spread']:.2f} between the two N)" if math.isfinite(out.get("beta_spread", math.nan))
+                        else ")"))
+    if "period_exponent" in out:
+        parts.append(f"the cycle period scales as d^{out['period_exponent']:.2f} "
+                     f"({out['period_near']:.3g} at d = {out['d_period_near']:.2g})")
+    hopf = None
+    if "growth_diverges" in out:
+        hopf = not out["growth_diverges"] and abs(out.get("period_exponent", 0.0)) < 0.25
+    out["hopf"] = hopf
+    verdict = {True: "consistent with a Hopf bifurcation", False: "not a Hopf bifurcation",
+               None: "not classified (no spectrum)"}[hopf]
+    out["text"] = f"Micro's transition is {verdict}: " + "; ".join(parts) + "." if parts else verdict
+    return out
 
 
 # ============================================================================ power law

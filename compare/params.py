@@ -1,16 +1,19 @@
 """What the user sets: the comparison's parameters, in one frozen dataclass that
 validates itself on construction (a bad value fails at once and names itself).
 
-Three presets: :meth:`Settings.default` (the paper's parameters, sized to finish in a
-few minutes on 2 cores), :meth:`Settings.quick` (a smoke run, what the tests use) and
-:meth:`Settings.paper` (every k0 of Figs. 4 and 8, a finer bin; opt-in, hours).  Any
+Three presets: :meth:`Settings.default` (the paper's parameters, sized to finish in
+about a minute on 2 cores), :meth:`Settings.quick` (a smoke run, what the tests use) and
+:meth:`Settings.paper` (more points, finer N-block runs and the paper's Figs. 3 and 10;
+opt-in, minutes).  Any
 field can be changed with :func:`dataclasses.replace` or :meth:`Settings.with_`.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, replace
 from typing import Any
+
+import numpy as np
 
 import micro
 import rsf
@@ -33,6 +36,10 @@ def _velocity_ratios(name: str, values) -> tuple[float, ...]:
     return tuple(sorted(positive_array(name, values, low=0.0, high=1e6)))
 
 
+def _geom(lo: float, hi: float, n: int) -> tuple[float, ...]:
+    return tuple(float(f"{v:.6g}") for v in np.geomspace(lo, hi, n))
+
+
 @dataclass(frozen=True)
 class Settings:
     r"""Parameters of a comparison run.
@@ -40,71 +47,83 @@ class Settings:
     Model (the paper's Figs. 3-4): ``k1, k2, zbar`` (exponential pinning distances with
     mean ``zbar`` and cutoff ``cutoff``), ``eta_u = f_th = 1``.
 
-    Micro numerics: the bin ``eps`` (its error in σ is about second order in eps; the
-    default is coarse, see docs/compare.md), and the stopping rule ``rtol`` (the paper's
-    1 %), ``atol`` (absolute stress tolerance of the steady test: below the
-    discretisation error, it stops runs whose 1 % of a tiny velocity weakening would be
-    smaller than the jitter of the grid) and ``t_max`` (None: micro's default).
+    Micro's steady branch and V^c are exact (the direct method, ``micro.steady_sliding``
+    and ``micro.critical_velocity``, to 1e-11); only its stick-slip cycles are
+    time-stepped, by the Fokker-Planck equation at the bin ``eps`` (and ``eps_coarse`` for
+    the error bars of the transition) with the stopping rule ``rtol``, ``atol``, ``t_max``
+    (None: micro's default), and by the N-block simulation.
 
     Parameters
     ----------
-    k0 : driving stiffnesses of the bifurcation diagram (Figs. 4/8).
-    diagram_ratios : velocities of the micro diagram as multiples of the RS critical
-        velocity with the paper's constants (Eq. 10, D_c = 0.06) — a placement guess only.
-    reference_k0 : a stiffness k0 >= k2, at which micro slides steadily at every V; its
-        steady branch reaches V ~ B and pins the shape of Eq. (10).
-    reference_V : velocities of that branch.
+    k0 : stiffnesses of the bifurcation diagram (Figs. 4/8): micro's exact V^c and steady
+        branch at each; the RS side always shows the paper's five.
+    branch_points, branch_span, branch_V_max : stable-branch velocities per k0, log-spaced
+        from V^c (1 + 1e-3) to min(branch_span V^c, branch_V_max) (at least 10 V^c).
+    unstable_points, unstable_from : velocities of the unstable branch (its growth rate),
+        from unstable_from V^c to 0.995 V^c.
+    reference_k0, reference_V : a stiffness k0 >= k2, at which micro slides steadily at
+        every V; its branch on ``reference_V`` reaches V ~ B and pins the shape of Eq. (10).
+    fp_points : (k0, V / V^c) of the Fokker-Planck stick-slip points that the D_c fit
+        matches (with exact steady points at ``steady_ratios`` V^c at the same k0); ``fp_k0``
+        is the set of their k0.  Near V^c the FP cost grows (a cycle a few bins high settles
+        slowly), at k0 = 0.3 faster than at 0.1: the default keeps k0 = 0.3 below 0.45 V^c.
     dc_bounds, dc_grid, bootstrap : D_c search range, scan resolution, bootstrap samples.
-    hopf_k0 : k0 of the Hopf-scaling comparison; ``hopf_distances``: (Vc - V)/Vc of the
-        micro points; ``hopf_rel_tol``: bisection tolerance of micro's Vc there.
-    phase_sets : (k1, k2) sets of Fig. 5; ``phase_k0``: candidate k0 (only k0 < k2 are
-        bisected); ``phase_rel_tol``: bisection tolerance; ``phase_eps``: its bin;
-        ``phase_reference_V``: velocities of each set's reference steady branch (the RS law
-        of that set is fitted to it).
-    critical_k0, critical_rel_tol : k0 whose micro Vc is bisected (at ``eps``) for the
-        table of critical velocities, and the bisection tolerance; the other k0 get the
-        bracket of their diagram points.
-    vc_refine : every micro bisection (critical, Hopf, phase) checks oscillations smaller
-        than 2 eps at eps / 2 (``micro.critical_velocity``'s ``refine``): several times
-        the cost near Vc, without it Vc carries the grid's error (docs/compare.md).
+    hopf_k0 : k0 of the transition study; ``hopf_distances``: d = (V^c - V)/V^c of its FP
+        points (at ``eps`` and ``eps_coarse``); ``nblock_N``, ``nblock_distances``: the
+        N-block sizes and distances; ``rs_hopf_distances``: the RS ones.
+    phase_sets : (k1, k2) sets of Fig. 5; ``phase_points`` k0 per set, log-spaced from
+        ``phase_k0_min`` to 0.98 k2 (micro has no stick-slip for k0 >= k2);
+        ``phase_reference_V``: velocities of each set's reference branch (the RS law of that
+        set is fitted to it).
     rs_points : velocities per k0 of the RS bifurcation curves.
     classical_b : b of the classical RS law, Eq. (7) (raised to 1.5 W(V) if smaller, so
         that a = b - W(V) > 0).
     shs_k0, shs_V, hold_times : slide-hold-slide (Fig. 7): stiffness, drive velocity (must
         be steady) and hold times.
+    paper_figures : also the paper's Fig. 3 (sigma(t) at k0 = 0.01) and Fig. 10 (the FP's
+        sigma against eps at ``fig10_k0``, ``fig10_eps``, against the exact value).
     """
 
-    k0: tuple[float, ...] = (0.3, 0.1, 0.01)
+    k0: tuple[float, ...] = PAPER_K0
     k1: float = 0.1
     k2: float = 0.9
     zbar: float = 0.1
     cutoff: float = 10.0
     eps: float = 0.016
+    eps_coarse: float = 0.025
     rtol: float = 1e-2
     atol: float = 1e-4
     t_max: float | None = None
-    diagram_ratios: tuple[float, ...] = (0.15, 0.4, 2.5, 5.0)
+    branch_points: int = 40
+    branch_span: float = 100.0
+    branch_V_max: float = 2e4
+    unstable_points: int = 16
+    unstable_from: float = 0.02
     reference_k0: float = 1.0
-    reference_V: tuple[float, ...] = (0.1, 0.3, 1.0, 3.0)
+    reference_V: tuple[float, ...] = _geom(1e-3, 1e3, 25)
+    fp_points: tuple[tuple[float, float], ...] = ((0.3, 0.15), (0.3, 0.4), (0.1, 0.15), (0.1, 0.4), (0.1, 0.55),
+                                                  (0.1, 0.7))
+    steady_ratios: tuple[float, ...] = (1.5, 3.0)
     dc_bounds: tuple[float, float] = (0.005, 0.5)
     dc_grid: int = 41
     bootstrap: int = 400
-    critical_k0: tuple[float, ...] = (0.1,)
-    critical_rel_tol: float = 0.1
-    vc_refine: bool = True
     rs_points: int = 50
     hopf_k0: float = 0.1
-    hopf_distances: tuple[float, ...] = (0.15, 0.3, 0.5, 0.7)
-    hopf_rel_tol: float = 0.1
+    hopf_distances: tuple[float, ...] = (0.3, 0.45, 0.6)
+    nblock_N: tuple[int, ...] = (30000, 100000)
+    nblock_distances: tuple[float, ...] = (0.02, 0.05, 0.1, 0.2, 0.3)
+    rs_hopf_distances: tuple[float, ...] = _geom(1e-3, 0.6, 12)
     phase_sets: tuple[tuple[float, float], ...] = PAPER_SETS
-    phase_k0: tuple[float, ...] = (0.3,)
-    phase_rel_tol: float = 0.25
-    phase_eps: float = 0.025
-    phase_reference_V: tuple[float, ...] = (0.1, 0.3, 1.0, 3.0)
+    phase_points: int = 24
+    phase_k0_min: float = 1e-4
+    phase_reference_V: tuple[float, ...] = _geom(1e-3, 1e3, 19)
     shs_k0: float = 0.1
     shs_V: float = 10.0
     hold_times: tuple[float, ...] = (0.1, 0.3, 1.0, 2.0, 4.0, 8.0, 16.0)
     classical_b: float = 0.01
+    paper_figures: bool = False
+    fig10_k0: tuple[float, ...] = (0.3, 0.1)
+    fig10_eps: tuple[float, ...] = (0.025, 0.02, 0.016, 0.0125)
     scenarios: tuple[str, ...] = SCENARIOS
     preset: str = "default"
 
@@ -118,32 +137,50 @@ class Settings:
         if self.cutoff <= self.zbar:
             raise ValueError(f"cutoff must be > zbar = {self.zbar!r}, got {self.cutoff!r}")
         set_("eps", positive("eps", self.eps))
-        set_("phase_eps", positive("phase_eps", self.phase_eps))
+        set_("eps_coarse", positive("eps_coarse", self.eps_coarse))
+        if not self.eps_coarse > self.eps:
+            raise ValueError(f"eps_coarse must be > eps = {self.eps!r}, got {self.eps_coarse!r}")
         set_("rtol", in_range("rtol", self.rtol, 0.0, 0.5, low_open=True))
         set_("atol", in_range("atol", self.atol, 0.0, 0.1))
         if self.t_max is not None:
             set_("t_max", positive("t_max", self.t_max))
-        set_("diagram_ratios", _velocity_ratios("diagram_ratios", self.diagram_ratios))
+        set_("branch_points", positive_int("branch_points", self.branch_points, low=5, high=1000))
+        set_("branch_span", in_range("branch_span", self.branch_span, 10.0, 1e6))
+        set_("branch_V_max", in_range("branch_V_max", self.branch_V_max, 1.0, 1e7))
+        set_("unstable_points", positive_int("unstable_points", self.unstable_points, low=3, high=1000))
+        set_("unstable_from", in_range("unstable_from", self.unstable_from, 1e-6, 0.9))
         set_("reference_k0", positive("reference_k0", self.reference_k0))
+        if self.reference_k0 < self.k2:
+            raise ValueError(f"reference_k0 must be >= k2 = {self.k2!r} (steady at every V), got {self.reference_k0!r}")
         set_("reference_V", _velocity_ratios("reference_V", self.reference_V))
+        points = []
+        for i, pair in enumerate(self.fp_points):
+            if len(tuple(pair)) != 2:
+                raise ValueError(f"fp_points[{i}] must be a (k0, V / V^c) pair, got {pair!r}")
+            points.append((in_range(f"fp_points[{i}].k0", pair[0], 0.0, 10.0, low_open=True),
+                           in_range(f"fp_points[{i}].ratio", pair[1], 0.0, 1.0, low_open=True, high_open=True)))
+        set_("fp_points", tuple(sorted(set(points), key=lambda p: (-p[0], p[1]))))
+        set_("steady_ratios", tuple(sorted(positive_array("steady_ratios", self.steady_ratios, low=1.0, high=1e4,
+                                                          min_size=0))))
         lo, hi = (positive(f"dc_bounds[{i}]", v) for i, v in enumerate(self.dc_bounds))
         if not hi > lo:
             raise ValueError(f"dc_bounds must be increasing, got {self.dc_bounds!r}")
         set_("dc_bounds", (lo, hi))
         set_("dc_grid", positive_int("dc_grid", self.dc_grid, low=7))
         set_("bootstrap", positive_int("bootstrap", self.bootstrap, low=0))
-        set_("critical_k0", tuple(sorted(positive_array("critical_k0", self.critical_k0, low=0.0, high=10.0, min_size=0),
-                                         reverse=True)))
-        set_("critical_rel_tol", in_range("critical_rel_tol", self.critical_rel_tol, 0.0, 1.0, low_open=True,
-                                          high_open=True))
-        if not isinstance(self.vc_refine, bool):
-            raise ValueError(f"vc_refine must be True or False, got {self.vc_refine!r}")
         set_("rs_points", positive_int("rs_points", self.rs_points, low=5))
         set_("classical_b", positive("classical_b", self.classical_b))
         set_("hopf_k0", positive("hopf_k0", self.hopf_k0))
-        set_("hopf_distances", tuple(sorted(positive_array("hopf_distances", self.hopf_distances,
-                                                           low=0.0, high=1.0, min_size=3))))
-        set_("hopf_rel_tol", in_range("hopf_rel_tol", self.hopf_rel_tol, 0.0, 1.0, low_open=True, high_open=True))
+        for name in ("hopf_distances", "nblock_distances", "rs_hopf_distances"):
+            values = tuple(sorted(positive_array(name, getattr(self, name), low=0.0, high=1.0,
+                                                 min_size=3 if name == "rs_hopf_distances" else 0)))
+            if any(d >= 1.0 for d in values):
+                raise ValueError(f"{name} must lie in (0, 1), got {getattr(self, name)!r}")
+            set_(name, values)
+        Ns = []
+        for i, n in enumerate(self.nblock_N):
+            Ns.append(positive_int(f"nblock_N[{i}]", n, low=100, high=10**7))
+        set_("nblock_N", tuple(sorted(Ns)))
         sets = []
         for i, pair in enumerate(self.phase_sets):
             if len(tuple(pair)) != 2:
@@ -152,45 +189,60 @@ class Settings:
             sets.append((in_range(f"phase_sets[{i}].k1", k1, 0.0, 100.0),
                          in_range(f"phase_sets[{i}].k2", k2, 0.0, 100.0, low_open=True)))
         set_("phase_sets", tuple(sets))
-        set_("phase_k0", tuple(sorted(positive_array("phase_k0", self.phase_k0, low=0.0, high=10.0), reverse=True)))
-        set_("phase_rel_tol", in_range("phase_rel_tol", self.phase_rel_tol, 0.0, 1.0, low_open=True, high_open=True))
+        set_("phase_points", positive_int("phase_points", self.phase_points, low=3, high=1000))
+        set_("phase_k0_min", in_range("phase_k0_min", self.phase_k0_min, 1e-6, 0.05))
         set_("phase_reference_V", _velocity_ratios("phase_reference_V", self.phase_reference_V))
         set_("shs_k0", positive("shs_k0", self.shs_k0))
         set_("shs_V", positive("shs_V", self.shs_V))
         set_("hold_times", tuple(sorted(positive_array("hold_times", self.hold_times, low=0.0, min_size=3))))
+        if not isinstance(self.paper_figures, bool):
+            raise ValueError(f"paper_figures must be True or False, got {self.paper_figures!r}")
+        set_("fig10_k0", tuple(sorted(positive_array("fig10_k0", self.fig10_k0, low=0.0, high=10.0, min_size=0),
+                                      reverse=True)))
+        set_("fig10_eps", tuple(sorted(positive_array("fig10_eps", self.fig10_eps, low=0.0, high=1.0, min_size=0),
+                                       reverse=True)))
         set_("scenarios", choices("scenarios", self.scenarios, SCENARIOS))
-        # every micro model must accept the bins (eps <= kappa zbar / 4 for the stiffest-free case)
-        for k0 in self.k0 + (self.reference_k0, self.hopf_k0, self.shs_k0):
-            self.numerics().settings(self.model(k0))
+        # every time-stepped micro model must accept the bins
+        for k0 in self.fp_k0 + (self.hopf_k0, self.shs_k0):
+            for eps in (self.eps, self.eps_coarse):
+                self.numerics(eps).settings(self.model(k0))
 
     # -- presets ---------------------------------------------------------------------------
     @classmethod
     def default(cls, **changes: Any) -> Settings:
-        """The paper's parameters, sized for a few minutes on 2 cores."""
+        """The paper's parameters, sized for about a minute on 2 cores."""
         return replace(cls(), **changes) if changes else cls()
 
     @classmethod
     def quick(cls, **changes: Any) -> Settings:
-        """A smoke run (tens of seconds): few points, a coarse bin.  Its numbers only show
-        that the pipeline works."""
-        base = cls(k0=(0.3,), eps=0.025, diagram_ratios=(0.3, 0.6, 3.0, 6.0), reference_V=(0.1, 0.3, 1.0, 3.0),
-                   dc_grid=13, bootstrap=50, critical_k0=(0.3,), critical_rel_tol=0.3, rs_points=12,
-                   hopf_k0=0.3, hopf_distances=(0.2, 0.4, 0.6, 0.8), hopf_rel_tol=0.3,
-                   phase_sets=((0.5, 0.5),), phase_k0=(0.3,), phase_rel_tol=0.3, phase_eps=0.025,
-                   phase_reference_V=(0.1, 0.3, 1.0, 3.0), shs_k0=0.3, shs_V=3.0, hold_times=(0.3, 1.0, 3.0, 10.0),
-                   vc_refine=False, preset="quick")
+        """A smoke run (seconds once compiled): few points, a coarse bin.  Its numbers only
+        show that the pipeline works."""
+        base = cls(eps=0.02, eps_coarse=0.025, branch_points=12, unstable_points=6, reference_V=_geom(1e-3, 1e3, 13),
+                   fp_points=((0.1, 0.2), (0.1, 0.4), (0.1, 0.6)), steady_ratios=(1.5,), dc_grid=13, bootstrap=50,
+                   rs_points=12, hopf_k0=0.1, hopf_distances=(0.4, 0.6, 0.8), nblock_N=(3000, 10000),
+                   nblock_distances=(0.1, 0.2, 0.4), rs_hopf_distances=(0.01, 0.1, 0.3, 0.6),
+                   phase_sets=((0.5, 0.5),), phase_points=8, phase_reference_V=_geom(1e-3, 1e3, 13),
+                   shs_k0=0.3, shs_V=3.0, hold_times=(0.3, 1.0, 3.0, 10.0), preset="quick")
         return replace(base, **changes) if changes else base
 
     @classmethod
     def paper(cls, **changes: Any) -> Settings:
-        """Every k0 of Figs. 4/8 and a denser phase diagram (opt-in: hours on 2 cores)."""
-        base = cls(k0=PAPER_K0, diagram_ratios=(0.01, 0.05, 0.1, 0.2, 0.35, 0.5, 0.65, 0.8, 0.9, 1.1, 1.3, 1.6, 2.0, 3.0, 5.0),
-                   reference_V=(0.003, 0.01, 0.03, 0.06, 0.1, 0.2, 0.3, 0.6, 1.0, 3.0, 10.0),
-                   phase_k0=(0.6, 0.3, 0.1, 0.03, 0.01, 0.003), phase_rel_tol=0.03, phase_eps=0.008,
-                   phase_reference_V=(0.01, 0.03, 0.1, 0.3, 1.0, 3.0),
-                   hopf_distances=(0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5), hopf_rel_tol=0.005,
-                   shs_V=1000.0, hold_times=(0.03, 0.1, 0.3, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0), preset="paper")
+        """More points, the paper's Figs. 3 and 10, finer N-block runs (opt-in: minutes)."""
+        base = cls(branch_points=80, unstable_points=32, reference_V=_geom(1e-3, 1e3, 49),
+                   fp_points=tuple([(0.3, r) for r in (0.05, 0.15, 0.3, 0.4, 0.55)] +
+                                   [(0.1, r) for r in (0.05, 0.15, 0.3, 0.4, 0.55, 0.7, 0.85)]),
+                   steady_ratios=(1.2, 1.5, 2.0, 3.0, 5.0),
+                   hopf_distances=(0.15, 0.3, 0.45, 0.6), nblock_N=(100000, 300000),
+                   nblock_distances=(0.01, 0.02, 0.03, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5),
+                   rs_hopf_distances=_geom(1e-4, 0.6, 20), phase_points=48,
+                   phase_reference_V=_geom(1e-3, 1e3, 37), shs_V=1000.0,
+                   hold_times=(0.03, 0.1, 0.3, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0), paper_figures=True, preset="paper")
         return replace(base, **changes) if changes else base
+
+    @property
+    def fp_k0(self) -> tuple[float, ...]:
+        """The k0 of ``fp_points``, largest first."""
+        return tuple(sorted({k0 for k0, _ in self.fp_points}, reverse=True))
 
     def with_(self, **changes: Any) -> Settings:
         """A copy with some fields changed (validated again)."""
@@ -209,15 +261,11 @@ class Settings:
         return micro.Convergence(rtol=self.rtol, atol=self.atol, t_max=self.t_max)
 
     def rs_guess_vc(self, k0: float) -> float:
-        """RS critical velocity with the paper's constants (used only to place points)."""
+        """RS critical velocity with the paper's constants (Eq. 10, D_c = 0.06)."""
         cv = rsf.critical_velocity(rsf.HyperbolicLaw(mu_inf=0.0), k0, rsf.PAPER_DC)
         if math.isfinite(cv.Vc):
             return float(cv.Vc)
         return rsf.PAPER_B  # stiff springs: no RS instability; centre the grid on V ~ B
-
-    def diagram_velocities(self, k0: float) -> tuple[float, ...]:
-        vc = self.rs_guess_vc(k0)
-        return tuple(float(f"{r * vc:.3g}") for r in self.diagram_ratios)
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)

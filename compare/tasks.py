@@ -22,11 +22,17 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 import micro
 
 from ._validation import in_range, positive
 
 __all__ = [
+    "SteadyTask",
+    "VcTask",
+    "NBlockTask",
+    "TraceTask",
     "StationaryTask",
     "CriticalTask",
     "SlideHoldSlideTask",
@@ -41,7 +47,7 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 #: Bump when the meaning or layout of a task's record changes.
-TASK_FORMAT = 1
+TASK_FORMAT = 2
 
 
 @lru_cache(maxsize=1)
@@ -216,7 +222,131 @@ class SlideHoldSlideTask(_TaskBase):
         return {"rows": frame.to_dict("records")}
 
 
-Task = StationaryTask | CriticalTask | SlideHoldSlideTask
+# ------------------------------------------------------------------ direct methods (ms per V)
+@dataclass(frozen=True)
+class SteadyTask(_TaskBase):
+    """``micro.steady_sliding(model, V)``: the exact steady state (either branch) at every
+    velocity of ``V``, with the branching ratio and the growth rate of the unstable mode."""
+
+    model: micro.Model
+    V: tuple[float, ...]
+    tol: float = 1e-11
+    kind = "steady"
+
+    def __post_init__(self) -> None:
+        V = tuple(float(v) for v in self.V)
+        if not V or any(not (math.isfinite(v) and v > 0.0) for v in V):
+            raise ValueError(f"V must be a non-empty sequence of finite velocities > 0, got {self.V!r}")
+        object.__setattr__(self, "V", V)
+        object.__setattr__(self, "tol", in_range("tol", self.tol, 1e-14, 1e-3))
+        model_description(self.model)
+
+    def describe(self) -> dict[str, Any]:
+        return {"kind": self.kind, "model": model_description(self.model), "V": list(self.V), "tol": self.tol}
+
+    def label(self) -> str:
+        m = self.model
+        return f"steady k0={m.k0:g} k1={m.k1:g} k2={m.k2:g} ({len(self.V)} V)"
+
+    def run(self) -> dict[str, Any]:
+        res = micro.steady_sliding(self.model, list(self.V), tol=self.tol, growth_rate=True, warn=False)
+        frame = res.to_frame()
+        frame["branching_error"] = np.ravel(res.branching_error)
+        return {"rows": frame.to_dict("records"), "message": res.message}
+
+
+@dataclass(frozen=True)
+class VcTask(_TaskBase):
+    """``micro.critical_velocity(model)`` by the direct method: the root of b(V) = 1."""
+
+    model: micro.Model
+    kind = "vc"
+
+    def __post_init__(self) -> None:
+        model_description(self.model)
+
+    def describe(self) -> dict[str, Any]:
+        return {"kind": self.kind, "model": model_description(self.model)}
+
+    def run(self) -> dict[str, Any]:
+        crit = micro.critical_velocity(self.model)
+        return crit.to_dict()
+
+
+@dataclass(frozen=True)
+class NBlockTask(_TaskBase):
+    """The stick-slip extrema of ``n_blocks`` blocks (``micro.nblock.stick_slip_extrema_nblock``):
+    means over ``n_cycles`` global shocks after ``n_discard``, with their standard errors."""
+
+    model: micro.Model
+    V: float
+    n_blocks: int
+    n_cycles: int = 10
+    n_discard: int = 5
+    seed: int = 0
+    kind = "nblock"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "V", positive("V", self.V))
+        for name, low in (("n_blocks", 10), ("n_cycles", 2), ("n_discard", 0), ("seed", 0)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        model_description(self.model)
+
+    def describe(self) -> dict[str, Any]:
+        return {"kind": self.kind, "model": model_description(self.model), "V": self.V, "n_blocks": self.n_blocks,
+                "n_cycles": self.n_cycles, "n_discard": self.n_discard, "seed": self.seed}
+
+    def run(self) -> dict[str, Any]:
+        from micro.nblock import stick_slip_extrema_nblock
+        r = stick_slip_extrema_nblock(self.model, self.V, self.n_blocks, n_cycles=self.n_cycles,
+                                      n_discard=self.n_discard, seed=self.seed)
+        return {"V": self.V, "n_blocks": self.n_blocks, "regime": r.regime, "sigma_max": r.sigma_max,
+                "sigma_max_stderr": r.sigma_max_stderr, "sigma_min": r.sigma_min,
+                "sigma_min_stderr": r.sigma_min_stderr, "period": r.period, "period_stderr": r.period_stderr,
+                "n_cycles": r.n_cycles, "status": r.status, "message": r.message}
+
+
+@dataclass(frozen=True)
+class TraceTask(_TaskBase):
+    """``micro.simulate(model, drive)``: the stress against time under a piecewise-constant
+    drive (``segments`` of (duration, velocity)), thinned to about ``n_samples`` samples."""
+
+    model: micro.Model
+    segments: tuple[tuple[float, float], ...]
+    numerics: micro.Numerics
+    n_samples: int = 4000
+    kind = "trace"
+
+    def __post_init__(self) -> None:
+        segs = tuple((float(d), float(v)) for d, v in self.segments)
+        micro.Drive(segs)  # validates durations and velocities
+        object.__setattr__(self, "segments", segs)
+        if not isinstance(self.numerics, micro.Numerics):
+            raise ValueError(f"numerics must be a micro.Numerics, got {type(self.numerics).__name__}")
+        self.numerics.settings(self.model)
+        model_description(self.model)
+
+    def describe(self) -> dict[str, Any]:
+        return {"kind": self.kind, "model": model_description(self.model),
+                "segments": [list(s) for s in self.segments], "n_samples": int(self.n_samples),
+                "numerics": _numerics_description(self.numerics, self.model)}
+
+    def label(self) -> str:
+        m = self.model
+        return f"trace k0={m.k0:g} V={max(v for _, v in self.segments):g}"
+
+    def run(self) -> dict[str, Any]:
+        duration = sum(d for d, _ in self.segments)
+        run = micro.simulate(self.model, micro.Drive(self.segments), numerics=self.numerics,
+                             record_dt=duration / self.n_samples)
+        rec = run.records
+        return {"t": np.asarray(rec.t, float).tolist(), "sigma": np.asarray(rec.sigma, float).tolist()}
+
+
+Task = SteadyTask | VcTask | NBlockTask | TraceTask | StationaryTask | CriticalTask | SlideHoldSlideTask
 
 #: Exceptions that are a deterministic answer for these inputs (cached like a result).
 DETERMINISTIC_ERRORS = (ValueError,)
@@ -250,4 +380,5 @@ def warm_up() -> float:
     start = time.perf_counter()
     model = micro.Model(k0=0.5)
     micro.simulate(model, 5.0, duration=0.5, numerics=micro.Numerics(eps=model.kappa * model.zbar / 4.0))
+    micro.steady_sliding(micro.Model(k0=0.1), [0.5, 2.0], warn=False)
     return time.perf_counter() - start
