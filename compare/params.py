@@ -235,7 +235,7 @@ class Settings:
                    hopf_distances=(0.15, 0.3, 0.45, 0.6), nblock_N=(100000, 300000),
                    nblock_distances=(0.01, 0.02, 0.03, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5),
                    rs_hopf_distances=_geom(1e-4, 0.6, 20), phase_points=48,
-                   phase_reference_V=_geom(1e-3, 1e3, 37), shs_V=1000.0,
+                   phase_reference_V=_geom(1e-3, 1e3, 37),
                    hold_times=(0.03, 0.1, 0.3, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0), paper_figures=True, preset="paper")
         return replace(base, **changes) if changes else base
 

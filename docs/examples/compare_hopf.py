@@ -1,4 +1,4 @@
-"""Hopf scaling (sigma_max - sigma_min against Vc - V, log-log) for both models with fitted exponents.
+"""The transition near V^c: micro's growth rate of the unstable mode, and both models' amplitude against (Vc - V)/Vc (each its own exact Vc), with fitted exponents.
 
     python docs/examples/compare_hopf.py [OUT_DIR] [--quick]
 

@@ -1,4 +1,4 @@
-"""Phase diagram in the (k0, V) plane (Fig. 5) for the paper's (k1, k2) sets: micro Vc by bisection, RS Vc with the 1/k0 asymptote and the k0 -> k2 limit.
+"""Phase diagram in the (k0, V) plane (Fig. 5) for the paper's (k1, k2) sets: micro's exact Vc at 24 k0 per set (direct method), RS Vc with the 1/k0 asymptote and the k0 -> k2 limit.
 
     python docs/examples/compare_phase.py [OUT_DIR] [--quick]
 
