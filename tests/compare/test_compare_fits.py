@@ -141,7 +141,9 @@ def test_steady_law_checks_on_an_exact_eq10_branch():
     fit = compare.fit_steady_law(frame)
     chk = compare.steady_law_checks(fit, {0.1: 0.89}, {0.1: 0.007})
     assert abs(chk.offset_error.iloc[0]) < 1e-9 and chk.tail_ratio.iloc[0] == pytest.approx(1.0, rel=1e-6)
-    assert chk.max_abs_residual.iloc[0] < 1e-12
+    # the fit stops at curve_fit's default tolerance (~1e-8 relative in the parameters): a
+    # residual of ~1e-10 is its convergence floor; a wrong form or a lost offset gives ~1e-3
+    assert chk.max_abs_residual.iloc[0] < 1e-8
 
 
 def test_classify_transition_tells_hopf_from_a_divergent_growth_rate():
