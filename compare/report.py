@@ -204,8 +204,9 @@ class _Study:
         self.tables["micro_branch"] = frame
         bad = frame[~frame.converged.astype(bool)]
         if len(bad):
-            log.warning("micro steady branch: %d of %d points did not reach the tolerance (largest sigma_error "
-                        "%.2g); they are kept and flagged", len(bad), len(frame), float(bad.sigma_error.max()))
+            log.warning("micro steady branch: %d of %d points did not reach the tolerance 1e-11 (largest "
+                        "sigma_error %.2g, branching_error %.2g); they are kept and flagged", len(bad), len(frame),
+                        float(bad.sigma_error.max()), float(bad.branching_error.max()))
         return frame
 
     @cached_property
@@ -255,9 +256,9 @@ class _Study:
         return fit.law(mu_inf=fit.mu_inf(near) + shift)
 
     # -- micro, time-stepped: the stick-slip points --------------------------------------------
-    def _stationary_task(self, k0: float, V: float, eps: float) -> StationaryTask:
+    def _stationary_task(self, k0: float, V: float, eps: float, method: str = "auto") -> StationaryTask:
         s = self.s
-        return StationaryTask(s.model(k0), _sig(V), s.numerics(eps), s.convergence())
+        return StationaryTask(s.model(k0), _sig(V), s.numerics(eps), s.convergence(), method)
 
     def _diagram_tasks(self) -> list[StationaryTask]:
         s = self.s
@@ -587,7 +588,8 @@ class _Study:
 
     def _fig10_tasks(self) -> list[StationaryTask]:
         s = self.s
-        return [self._stationary_task(k0, 1.5 * self.Vc(k0), eps) for k0 in s.fig10_k0 for eps in s.fig10_eps
+        # method "fp": above V^c the default would return the direct steady state, not the FP's
+        return [self._stationary_task(k0, 1.5 * self.Vc(k0), eps, "fp") for k0 in s.fig10_k0 for eps in s.fig10_eps
                 if eps <= s.model(k0).kappa * s.zbar / 4]
 
     def _paper_figures(self) -> None:

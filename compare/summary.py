@@ -219,13 +219,40 @@ def _shs(study, t, v) -> list[str]:
     return lines
 
 
+def _paper(t) -> list[str]:
+    lines = []
+    if "fig3_traces" in t:
+        tr = t["fig3_traces"]
+        late = [(V, g[g.t >= 0.5 * g.t.max()]) for V, g in tr.groupby("V")]
+        amp = ", ".join(f"V = {V:g}: {_fmt(g.sigma.max() - g.sigma.min(), 3)}" for V, g in late)
+        lines += ["## The paper's Fig. 3 (sigma(t), k0 = 0.01)", "",
+                  f"Late-time stress range (second half of each trace, FP): {amp}. Figure `fig3.png`.", ""]
+    if "fig10_eps" in t:
+        f = t["fig10_eps"]
+        lines += ["## The paper's Fig. 10 (the FP's stress against the bin, V = 1.5 V^c)", "",
+                  "| k0 | V | eps | regime | converged | sigma_FP − sigma_exact |", "|---|---|---|---|---|---|"]
+        for _, r in f.sort_values(["k0", "eps"], ascending=[False, False]).iterrows():
+            lines.append(f"| {r.k0:g} | {_fmt(r.V, 4)} | {r.eps:g} | {r.regime} | {bool(r.converged)} | "
+                         f"{_fmt(r.error, 2)} |")
+        bad = f[~f.converged.astype(bool)]
+        lines.append("")
+        if len(bad):
+            lines.append(f"As in the paper, the Fokker-Planck equation does not settle everywhere above V^c: at "
+                         f"{len(bad)} of {len(f)} (k0, eps) a stress oscillation a few k0·eps high persists to the "
+                         "time limit, a grid oscillation of the discretised density, not of the model (the direct "
+                         "steady state is linearly stable there).")
+        lines += ["", "Figure `fig10.png`.", ""]
+    return lines
+
+
 def _warnings(study, t) -> list[str]:
     notes = []
     b = t.get("micro_branch")
     if b is not None and (~b.converged.astype(bool)).any():
         bad = b[~b.converged.astype(bool)]
         notes.append(f"{len(bad)} exact steady points did not reach the tolerance 1e-11 (largest sigma_error "
-                     f"{_fmt(bad.sigma_error.max(), 2)}; V = {_fmt(bad.V.min(), 3)} to {_fmt(bad.V.max(), 3)}).")
+                     f"{_fmt(bad.sigma_error.max(), 2)}, branching_error {_fmt(bad.branching_error.max(), 2)}; "
+                     f"V = {_fmt(bad.V.min(), 3)} to {_fmt(bad.V.max(), 3)}).")
     for name in ("micro_points", "hopf_points"):
         f = t.get(name)
         if f is not None and "converged" in f and "method" in f:
@@ -263,6 +290,7 @@ def summary(study, rep) -> str:
     lines += _hopf(study, t, v)
     lines += _phase(study, t)
     lines += _shs(study, t, v)
+    lines += _paper(t)
     if rep.figures:
         lines += ["## Figures", ""] + [f"![{name}]({p.name})" for name, p in rep.figures.items()] + [""]
     lines += ["## Tables", "", ", ".join(f"`{n}.csv`" for n in sorted(t)), ""]

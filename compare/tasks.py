@@ -125,25 +125,30 @@ class _TaskBase:
 
 @dataclass(frozen=True)
 class StationaryTask(_TaskBase):
-    """``micro.stationary(model, V, numerics=..., convergence=...)``."""
+    """``micro.stationary(model, V, numerics=..., convergence=..., method=...)`` (``method="fp"``
+    time-steps the Fokker-Planck equation even where the direct steady state exists)."""
 
     model: micro.Model
     V: float
     numerics: micro.Numerics
     convergence: micro.Convergence
+    method: str = "auto"
     kind = "stationary"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "V", positive("V", self.V))
+        if self.method not in ("auto", "fp"):
+            raise ValueError(f"method must be 'auto' or 'fp', got {self.method!r}")
         _check_common(self.model, self.numerics, self.convergence)
 
     def describe(self) -> dict[str, Any]:
         return {"kind": self.kind, "model": model_description(self.model), "V": self.V,
                 "numerics": _numerics_description(self.numerics, self.model),
-                "convergence": _convergence_description(self.convergence)}
+                "convergence": _convergence_description(self.convergence), "method": self.method}
 
     def run(self) -> dict[str, Any]:
-        res = micro.stationary(self.model, self.V, numerics=self.numerics, convergence=self.convergence)
+        res = micro.stationary(self.model, self.V, numerics=self.numerics, convergence=self.convergence,
+                               method=self.method)
         return res.to_dict()
 
 

@@ -61,10 +61,22 @@ def test_cache_key_changes_with_every_parameter():
     variants = [StationaryTask(MODEL, 1.0 + 1e-9, NUM, CONV),
                 StationaryTask(micro.Model(k0=1.0, k1=0.2), 1.0, NUM, CONV),
                 StationaryTask(MODEL, 1.0, micro.Numerics(eps=0.031), CONV),
-                StationaryTask(MODEL, 1.0, NUM, micro.Convergence(rtol=2e-2))]
+                StationaryTask(MODEL, 1.0, NUM, micro.Convergence(rtol=2e-2)),
+                StationaryTask(MODEL, 1.0, NUM, CONV, "fp")]
     keys = {base.key} | {v.key for v in variants}
     assert len(keys) == 1 + len(variants)
     assert StationaryTask(micro.Model(k0=1.0), 1.0, micro.Numerics(eps=0.03), micro.Convergence()).key == base.key
+
+
+def test_fp_method_time_steps_where_the_direct_state_exists():
+    # Fig. 10 measures the FP's error against the direct steady state: a task that let
+    # "auto" answer would compare the direct method with itself (error 2e-8, flat in eps)
+    model = micro.Model(k0=0.3)
+    exact = float(micro.steady_sliding(model, 0.3, growth_rate=False).sigma)
+    auto = StationaryTask(model, 0.3, micro.Numerics(eps=0.025), CONV).run()
+    fp = StationaryTask(model, 0.3, micro.Numerics(eps=0.025), CONV, "fp").run()
+    assert abs(auto["sigma_mean"] - exact) < 1e-7
+    assert 2e-5 < abs(fp["sigma_mean"] - exact) < 1e-3  # the FP's first-order bin error
 
 
 def test_unreadable_cache_file_is_recomputed(tmp_path):
