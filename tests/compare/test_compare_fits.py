@@ -1,7 +1,6 @@
 """The fits against synthetic data with known answers and against closed forms."""
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pandas as pd

@@ -2,7 +2,6 @@
 convergence in the bin eps."""
 from __future__ import annotations
 
-import math
 
 import pytest
 

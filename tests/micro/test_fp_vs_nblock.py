@@ -10,7 +10,6 @@ tests use small N; the slow ones N >= 1e5, where the tolerance is a few 1e-5.
 """
 from __future__ import annotations
 
-import math
 
 import pytest
 
