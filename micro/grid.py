@@ -106,15 +106,17 @@ class Grid:
     model : the model.
     settings : numerical settings.
     initial : ``"frozen"`` (all delta_R = 0 and delta distributed as the overshoot of a
-        renewal process with increments kappa z: the V -> infinity state) or
+        renewal process with increments kappa z: the V -> infinity state),
         ``"relaxed"`` (every dashpot relaxed and delta distributed with increments
-        (k0 + k1) z: the V -> 0 state).
+        (k0 + k1) z: the V -> 0 state) or ``"uniform"`` (all delta_R = 0 and delta
+        uniform on [0, kappa zbar]: a start away from every stationary state, whose mean
+        margin is half the V -> infinity one, for transients and convergence tests).
     """
 
     def __init__(self, model: Model, settings: GridSettings, initial: str = "frozen") -> None:
         settings.check(model)
-        if initial not in ("frozen", "relaxed"):
-            raise ValueError(f"initial must be 'frozen' or 'relaxed', got {initial!r}")
+        if initial not in ("frozen", "relaxed", "uniform"):
+            raise ValueError(f"initial must be 'frozen', 'relaxed' or 'uniform', got {initial!r}")
         self.model = model
         self.settings = settings
         eps = settings.eps
@@ -179,10 +181,13 @@ class Grid:
         s_max = stiffness * model.jumps.z_max
         n_bins = int(math.ceil(s_max / eps)) + 1
         delta = (np.arange(n_bins * n_sub) + 0.5) * (eps / n_sub)
-        density = 1.0 - np.asarray(model.jumps.cdf(delta / stiffness))
+        if initial == "uniform":
+            density = (delta < model.kappa * model.zbar).astype(float)
+        else:
+            density = 1.0 - np.asarray(model.jumps.cdf(delta / stiffness))
         weight = density / density.sum()
         mean_delta = float(np.sum(weight * delta))
-        if initial == "frozen":
+        if initial != "relaxed":
             y = np.zeros_like(delta)
         else:
             y = model.k2 / (model.k0 + model.k1) * (mean_delta - delta)

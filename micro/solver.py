@@ -289,7 +289,7 @@ def simulate(
     model : the model.
     drive : a :class:`Drive`, or a constant velocity (then ``duration`` is required).
     numerics : bin and step limits.
-    initial : ``"auto"``, ``"frozen"``, ``"relaxed"`` or a :class:`~micro.grid.Grid` to
+    initial : ``"auto"``, ``"frozen"``, ``"relaxed"``, ``"uniform"`` (see :class:`~micro.grid.Grid`) or a :class:`~micro.grid.Grid` to
         start from (it is copied).
     record_dsigma, record_dt : record the stress whenever it has moved by
         ``record_dsigma`` and at least every ``record_dt`` (defaults from the model).
