@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -94,3 +95,48 @@ def test_module_entry_point_help():
     assert res.returncode == 0
     for option in ("--k0", "--Dc", "--V", "--A", "--B", "--mu-inf", "--out", "--law", "--cycle-rtol"):
         assert option in res.stdout
+
+
+def test_law_options_reach_the_model(tmp_path):
+    # every law option of the CLI against the Python API built by hand: a misrouted option
+    # (--eta-u, --k2, --law-a, --b, --state-law) changes V^c or the cycle by O(1)
+    out = tmp_path / "critical.csv"
+    assert main(["critical", "--k0", "0.1", "--law", "viscoelastic", "--k1", "0.2", "--eta-u", "2",
+                 "--zbar", "0.2", "--out", str(out)]) == 0
+    law = rsf.ViscoelasticLaw(zbar=0.2, k1=0.2, eta_u=2.0, k0=0.1)
+    got, want = pd.read_csv(out).Vc[0], rsf.critical_velocity(law, 0.1, rsf.params.PAPER_DC).Vc
+    assert got == pytest.approx(want, rel=1e-12)
+    assert abs(want / rsf.critical_velocity(rsf.ViscoelasticLaw(k0=0.1), 0.1, rsf.params.PAPER_DC).Vc - 1) > 0.1
+
+    # log law above its critical stiffness (b - a)/Dc = 0.13: steady at mu0 + (a - b) ln(V/v0)
+    out = tmp_path / "sweep.csv"
+    log = ["--law", "log", "--b", "0.02", "--law-a", "0.012", "--a", "0.012", "--v0", "0.5"]
+    assert main(["sweep", "--k0", "0.3", *log, "--V", "2", "--out", str(out)]) == 0
+    got = pd.read_csv(out).iloc[0]
+    assert got.regime == "steady"
+    assert got.sigma_mean == pytest.approx(0.6 - 0.008 * np.log(4.0), abs=1e-9)
+    # ... and a velocity step 1 -> 3 with the slip law, sample by sample against the API
+    out = tmp_path / "run.csv"
+    assert main(["run", "--k0", "0.3", *log, "--state-law", "slip", "--steps", "1:5,3", "--t-end", "10",
+                 "--out", str(out)]) == 0
+    series = pd.read_csv(out)
+    model = rsf.SpringSlider(rsf.LogLaw(mu0=0.6, a=0.012, b=0.02, v0=0.5), k0=0.3, a=0.012, state_law="slip")
+    api = rsf.simulate(model, t_end=10.0, protocol=rsf.Protocol.velocity_steps([1.0, 3.0], [5.0]))
+    aging = rsf.simulate(rsf.SpringSlider(model.law, k0=0.3, a=0.012), t_end=10.0,
+                         protocol=rsf.Protocol.velocity_steps([1.0, 3.0], [5.0]))
+    assert len(series) == len(api.t) and np.abs(series.sigma.to_numpy() - api.sigma).max() < 1e-12
+    t = np.linspace(5.0, 5.2, 41)  # the transient after the step (slip ~ D_c): the two laws differ
+    assert np.abs(np.interp(t, aging.t, aging.sigma) - np.interp(t, api.t, api.sigma)).max() > 1e-4
+
+
+def test_run_slide_hold_slide_and_steps_match_the_api(tmp_path):
+    out = tmp_path / "run.csv"
+    assert main(["run", "--k0", "0.3", "--shs", "1", "5", "2", "--t-end", "12", "--out", str(out)]) == 0
+    series = pd.read_csv(out)
+    api = rsf.simulate(rsf.SpringSlider(k0=0.3), t_end=12.0,
+                       protocol=rsf.Protocol.slide_hold_slide(1.0, 5.0, 2.0))
+    assert series.t.iloc[-1] == pytest.approx(12.0)
+    assert len(series) == len(api.t) and abs(series.sigma.to_numpy() - api.sigma).max() < 1e-12
+    # the hold (t in [5, 7]): with the load point at rest the stress cannot rise
+    hold = series[(series.t > 5.0 + 1e-9) & (series.t < 7.0 - 1e-9)]
+    assert len(hold) > 1 and np.all(np.diff(hold.sigma) <= 1e-12)
