@@ -52,6 +52,15 @@ def test_shs_scenario_end_to_end(tmp_path):
     assert best["classical RS Eq. (7)"] == "logarithmic"
     assert "Slide-hold-slide" in (out / "summary.md").read_text()
 
+    # the same without the cache and in this process: every point recomputed, the same table
+    again = tmp_path / "again"
+    proc = _run(["--quick", "--scenario", "shs", "--dc", "0.06", "--no-cache", "--workers", "1", "--out", str(again)],
+                tmp_path / "cache", 300)
+    assert proc.returncode == 0, proc.stderr
+    text = (again / "summary.md").read_text()
+    assert " 0 from the cache" in text and " 0 micro tasks computed" not in text
+    pd.testing.assert_frame_equal(pd.read_csv(again / "shs_fit.csv"), fit, rtol=1e-12)
+
 
 @pytest.mark.slow
 def test_quick_report_end_to_end(tmp_path):
@@ -67,3 +76,14 @@ def test_quick_report_end_to_end(tmp_path):
         assert heading in summary
     again = _run(["--quick", "--out", str(out)], tmp_path / "cache", 900)   # every micro point cached
     assert "0 micro tasks computed" in again.stdout
+
+
+@pytest.mark.slow
+def test_paper_preset_runs_a_scenario(tmp_path):
+    # --paper: more hold times for slide-hold-slide (9 against the default's)
+    out = tmp_path / "report"
+    proc = _run(["--paper", "--scenario", "shs", "--dc", "0.06", "--out", str(out)], tmp_path / "cache", 900)
+    assert proc.returncode == 0, proc.stderr
+    points = pd.read_csv(out / "shs_points.csv")
+    assert points.hold_time.nunique() == 9
+    assert "Preset `paper`" in (out / "summary.md").read_text()

@@ -124,3 +124,19 @@ def test_fit_dc_rejects_bad_bounds():
     import pandas as pd
     with pytest.raises(ValueError, match=r"bounds"):
         compare.fit_dc(pd.DataFrame(columns=["k0", "V", "regime", "sigma_max", "sigma_min"]), None, bounds=(0.1, 0.01))
+
+
+@pytest.mark.slow
+def test_dask_local_cluster_gives_the_serial_result(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    tasks = _tasks()
+    with Runner(PointCache(tmp_path / "serial"), workers=1, progress=False) as r:
+        serial = r.run(tasks)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        with Runner(PointCache(tmp_path / "dask"), scheduler=client, progress=False) as r:
+            remote = r.run(tasks)
+            assert r.stats.computed == len(tasks) and "dask" in r.mode
+    strip = lambda recs: [{**r, "result": {k: v for k, v in r["result"].items() if k != "wall_time"}}  # noqa: E731
+                          for r in recs]
+    assert _same(strip(remote), strip(serial))  # everything but the wall time

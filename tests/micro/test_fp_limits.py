@@ -68,7 +68,12 @@ def test_slow_large_velocity_limit_at_V_1000():
 
 @pytest.mark.slow
 def test_slow_small_velocity_limit():
-    # k0 > k2, V -> 0: sigma = f_th - (k0 + k1) <z^2>/(2<z>) - eta_u V + O(V^2)
+    # k0 > k2, V -> 0: sigma = f_th - (k0 + k1) <z^2>/(2<z>) - eta_u V + O(V^2).  The limit
+    # and its eta_u V term are tested exactly on the direct method (test_renewal.py: the
+    # O(V^2) remainder); here the FP meets the exact stress at V = 0.002 (0.2 below the fast
+    # limit's, 5 min at eps = 0.016).  Measured: 1.4e-3 off, 70 % of the eta_u V term: at
+    # this bin the FP cannot resolve that term, only the limit itself.
     V = 0.002
-    exact = micro.sigma_slow_limit(STIFF, V)
+    exact = float(micro.steady_sliding(STIFF, V, growth_rate=False).sigma)
+    assert abs(exact - micro.sigma_slow_limit(STIFF, V)) < 5e-5
     assert _steady(STIFF, V, 0.016) == pytest.approx(exact, abs=2e-3)
