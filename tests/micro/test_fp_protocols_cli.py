@@ -43,6 +43,7 @@ def test_cli_sweep_and_run_write_the_documented_columns(tmp_path):
     assert list(table.regime) == ["stick-slip", "steady"]
     steady = table.iloc[1]
     assert steady.sigma_max == steady.sigma_min == steady.sigma_mean
+    assert steady.sigma_mean == pytest.approx(0.893759123072792, abs=1e-10)  # the exact steady state
     assert table.iloc[0].sigma_max > table.iloc[0].sigma_min + 0.03
 
     out = tmp_path / "run.csv"
