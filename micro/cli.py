@@ -8,9 +8,14 @@ kappa*zbar/50 (2e-3 for these parameters); its error on a stationary stress is a
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
+import math
+import os
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 import pandas as pd
 
@@ -22,14 +27,58 @@ from .solver import Convergence, Numerics, critical_velocity, default_eps, simul
 log = logging.getLogger("micro")
 
 
-def _floats(text: str, name: str) -> list[float]:
-    try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--{name} must be comma-separated numbers, got {text!r}") from None
-    if not values:
-        raise argparse.ArgumentTypeError(f"--{name} needs at least one value")
+#: Largest drive velocity and stiffness the commands accept (V^c ~ 0.08/k0 reaches 1e7 at
+#: k0 ~ 1e-8; beyond these the stresses lose every significant digit).
+V_RANGE = (1e-6, 1e7)
+K0_MAX = 1e3
+
+
+def _floats(text: str, name: str, low: float, high: float) -> list[float]:
+    """Every item of a comma-separated list, each finite and in [low, high], or one error
+    naming the option and the item."""
+    items = text.split(",")
+    values = []
+    for i, item in enumerate(items):
+        try:
+            v = float(item)
+        except ValueError:
+            raise ValueError(f"--{name} item {i + 1} of {len(items)} must be a number, got {item.strip()!r}") from None
+        if not (math.isfinite(v) and low <= v <= high):
+            raise ValueError(f"--{name} item {i + 1} must be in [{low:g}, {high:g}], got {item.strip()!r}")
+        values.append(v)
     return values
+
+
+def _check_out(path: str, option: str = "--out") -> Path:
+    """The CSV can be written there: fail now, not after the computation."""
+    if not path.strip():
+        raise ValueError(f"{option} must name a CSV file, got {path!r}")
+    out = Path(path)
+    if out.is_dir():
+        raise ValueError(f"{option} {path!r} is a directory; give a file name")
+    parent = out.parent
+    if not parent.is_dir():
+        raise ValueError(f"{option} {path!r}: the directory {str(parent)!r} does not exist")
+    try:
+        fd, probe = tempfile.mkstemp(dir=parent, prefix=f".{out.name}.", suffix=".tmp")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise ValueError(f"{option} {path!r}: cannot write in {str(parent)!r} ({exc.strerror})") from None
+    return out
+
+
+def _write_csv(frame: pd.DataFrame, out: Path) -> None:
+    """Atomically: a temporary file beside ``out``, renamed over it once complete."""
+    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", newline="") as f:
+            frame.to_csv(f, index=False)
+        os.replace(tmp, out)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
 
 
 def _schedule(text: str) -> Drive:
@@ -45,6 +94,9 @@ def _schedule(text: str) -> Drive:
 
 
 def _model_options(p: argparse.ArgumentParser, *, k0_list: bool = False) -> None:
+    # -v also after the subcommand (SUPPRESS: an absent sub-level flag keeps the top-level one)
+    p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+                   help="log progress to stderr")
     g = p.add_argument_group("model (defaults: the paper's Fig. 4)")
     if k0_list:
         g.add_argument("--k0", required=True, help="driving-spring stiffness(es), > 0; comma-separated for several")
@@ -138,45 +190,49 @@ def main(argv: list[str] | None = None) -> int:
 
 def _run(args) -> int:
     start = time.perf_counter()
+    # everything is checked before anything is computed
+    out = _check_out(args.out)
+    k0s = _floats(args.k0, "k0", 0.0, K0_MAX) if args.command == "critical" else [args.k0]
+    models = [_model(args, k0) for k0 in k0s]
+    if models[0].k0 > K0_MAX:
+        raise ValueError(f"--k0 must be in (0, {K0_MAX:g}], got {args.k0!r}")
+    numerics, convergence = _numerics(args)
+    for model in models:
+        numerics.settings(model)
     if args.command == "steady":
-        velocities = _floats(args.V, "V")
-        model = _model(args, args.k0)
-        res = steady_sliding(model, velocities, growth_rate=args.growth_rate)
+        velocities = _floats(args.V, "V", *V_RANGE)
+        res = steady_sliding(models[0], velocities, growth_rate=args.growth_rate)
         frame = res.to_frame()
-        frame.to_csv(args.out, index=False)
-        print(f"wrote {len(frame)} rows to {args.out} in {time.perf_counter() - start:.2f} s"
+        _write_csv(frame, out)
+        print(f"wrote {len(frame)} rows to {out} in {time.perf_counter() - start:.2f} s"
               f"{'' if frame.converged.all() else ' (' + res.message + ')'}", file=sys.stderr)
         return 0 if frame.converged.all() else 3
     if args.command == "sweep":
-        velocities = _floats(args.V, "V")
-        model = _model(args, args.k0)
-        numerics, convergence = _numerics(args)
+        velocities = _floats(args.V, "V", *V_RANGE)
         rows = []
-        for V in velocities:
-            res = stationary(model, V, numerics=numerics, convergence=convergence)
+        for i, V in enumerate(velocities):
+            res = stationary(models[0], V, numerics=numerics, convergence=convergence)
             rows.append(res.to_dict())
-            print(f"V={V:g}: {res.regime}, sigma_max={res.sigma_max:.6f}, sigma_min={res.sigma_min:.6f}"
+            print(f"[{i + 1}/{len(velocities)}, {time.perf_counter() - start:.0f} s] V={V:g}: {res.regime}, "
+                  f"sigma_max={res.sigma_max:.6f}, sigma_min={res.sigma_min:.6f}"
                   f"{'' if res.converged else ' (NOT converged: ' + res.message + ')'}", file=sys.stderr)
         frame = pd.DataFrame(rows)
-        frame.to_csv(args.out, index=False)
-        print(f"wrote {len(frame)} rows to {args.out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
+        _write_csv(frame, out)
+        print(f"wrote {len(frame)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0 if frame.converged.all() else 3
     if args.command == "critical":
         rows = []
-        for k0 in _floats(args.k0, "k0"):
-            model = _model(args, k0)
-            numerics, convergence = _numerics(args)
+        for i, model in enumerate(models):
             crit = critical_velocity(model, V_min=args.V_min, V_max=args.V_max, rel_tol=args.rel_tol,
                                      numerics=numerics, convergence=convergence, refine=args.refine,
                                      method=args.method)
             rows.append(crit.to_dict())
-            print(f"k0={k0:g}: Vc={crit.Vc:.6g} ({crit.status})", file=sys.stderr)
-        pd.DataFrame(rows).to_csv(args.out, index=False)
-        print(f"wrote {len(rows)} rows to {args.out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
+            print(f"[{i + 1}/{len(models)}, {time.perf_counter() - start:.0f} s] k0={model.k0:g}: "
+                  f"Vc={crit.Vc:.6g} ({crit.status})", file=sys.stderr)
+        _write_csv(pd.DataFrame(rows), out)
+        print(f"wrote {len(rows)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0
     # run
-    model = _model(args, args.k0)
-    numerics, _ = _numerics(args)
     if args.V is not None:
         if args.duration is None:
             raise ValueError("--duration is required with --V")
@@ -186,10 +242,10 @@ def _run(args) -> int:
     else:
         v, slide, hold, resume = args.shs
         drive = Drive.slide_hold_slide(v, slide, hold, resume)
-    run = simulate(model, drive, numerics=numerics)
-    run.records.to_csv(args.out, index=False)
-    eps = numerics.eps if numerics.eps is not None else default_eps(model)
-    print(f"wrote {len(run.records)} rows to {args.out} (eps={eps:g}) in {time.perf_counter() - start:.1f} s",
+    run = simulate(models[0], drive, numerics=numerics)
+    _write_csv(run.records, out)
+    eps = numerics.eps if numerics.eps is not None else default_eps(models[0])
+    print(f"wrote {len(run.records)} rows to {out} (eps={eps:g}) in {time.perf_counter() - start:.1f} s",
           file=sys.stderr)
     return 0
 

@@ -714,6 +714,11 @@ def critical_velocity(
         if status != "converged":
             log.info("micro.critical_velocity(k0=%g, k1=%g, k2=%g): %s", model.k0, model.k1, model.k2, message)
         return Critical(model, Vc, low, high, status, message, evaluations)
+    if model.k2 == 0.0 or model.k0 >= model.k2:
+        # closed form: steady sliding is stable at every V, nothing to bisect
+        return _reported(Critical(model, 0.0, 0.0, V_min, "no stick-slip",
+                                  f"k0 = {model.k0:g} >= k2 = {model.k2:g}: steady sliding is stable at every V "
+                                  "(branching ratio below 1), no stick-slip", []))
     evaluations: list[dict] = []
 
     convergence = convergence or Convergence()

@@ -75,10 +75,18 @@ class CriticalVelocity:
         """Whether steady sliding at V is linearly stable."""
         return not any(lo < V < hi for lo, hi in self.unstable)
 
+    @property
+    def status(self) -> str:
+        """``'unstable band'``, ``'stable at every V'`` (Vc is nan: k0 Dc exceeds the largest
+        -V dmu_ss/dV) or ``'unstable at large V'`` (Vc is inf)."""
+        if math.isnan(self.Vc):
+            return "stable at every V"
+        return "unstable at large V" if math.isinf(self.Vc) else "unstable band"
+
     def to_frame(self) -> pd.DataFrame:
-        """One row: k0, Dc, Vc, V_lower, method."""
+        """One row: k0, Dc, Vc, V_lower, method, status."""
         return pd.DataFrame([{"k0": self.k0, "Dc": self.Dc, "Vc": self.Vc,
-                              "V_lower": self.V_lower, "method": self.method}])
+                              "V_lower": self.V_lower, "method": self.method, "status": self.status}])
 
 
 def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: float = 0.06, *,

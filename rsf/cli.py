@@ -12,8 +12,13 @@ converge or the integration failed (the CSV then says which, in the status/messa
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
+import math
+import os
 import sys
+import tempfile
+from pathlib import Path
 from typing import Sequence
 
 import numpy as np
@@ -29,14 +34,61 @@ __all__ = ["main", "build_parser"]
 logger = logging.getLogger(__name__)
 
 
+#: Documented upper bounds on magnitudes (beyond them a run loses its digits or never ends).
+K0_MAX, V_MAX, T_END_MAX, N_V_MAX = 1e3, 1e7, 1e8, 10_000
+
+
 def _floats(text: str) -> list[float]:
-    try:
-        values = [float(x) for x in text.replace(" ", "").split(",") if x]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
-    if not values:
-        raise argparse.ArgumentTypeError("expected at least one number")
+    """Every item of a comma-separated list, each a finite number (no empty items)."""
+    items = text.replace(" ", "").split(",")
+    values = []
+    for i, item in enumerate(items):
+        try:
+            v = float(item)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"item {i + 1} of {len(items)} must be a number, got {item!r}") from None
+        if not math.isfinite(v):
+            raise argparse.ArgumentTypeError(f"item {i + 1} must be finite, got {item!r}")
+        values.append(v)
     return values
+
+
+def _check_out(path: str | None, option: str) -> None:
+    """The CSV can be written there (``None`` or ``-``: standard output): fail before computing."""
+    if path is None or path == "-":
+        return
+    if not path.strip():
+        raise ValueError(f"{option} must name a CSV file (or - for standard output), got {path!r}")
+    out = Path(path)
+    if out.is_dir():
+        raise ValueError(f"{option} {path!r} is a directory; give a file name")
+    if not out.parent.is_dir():
+        raise ValueError(f"{option} {path!r}: the directory {str(out.parent)!r} does not exist")
+    try:
+        fd, probe = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise ValueError(f"{option} {path!r}: cannot write in {str(out.parent)!r} ({exc.strerror})") from None
+
+
+def _check_magnitudes(args: argparse.Namespace) -> None:
+    k0s = args.k0 if isinstance(args.k0, list) else [args.k0]
+    for k0 in k0s:
+        if not (0.0 < k0 <= K0_MAX):
+            raise ValueError(f"--k0 must be in (0, {K0_MAX:g}], got {k0!r}")
+    for V in getattr(args, "V", None) if isinstance(getattr(args, "V", None), list) else [getattr(args, "V", None)]:
+        if V is not None and not (0.0 < V <= V_MAX):
+            raise ValueError(f"--V must be in (0, {V_MAX:g}], got {V!r}")
+    t_end = getattr(args, "t_end", None)
+    if t_end is not None and not (0.0 < t_end <= T_END_MAX):
+        raise ValueError(f"--t-end must be in (0, {T_END_MAX:g}], got {t_end!r}")
+    rng = getattr(args, "V_range", None)
+    if rng is not None:
+        vmin, vmax, n = rng
+        if not (0 < vmin < vmax <= V_MAX and float(n).is_integer() and 1 <= n <= N_V_MAX):
+            raise ValueError(f"--V-range needs 0 < VMIN < VMAX <= {V_MAX:g} and an integer N in [1, {N_V_MAX}], "
+                             f"got {vmin!r} {vmax!r} {n!r}")
 
 
 def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> None:
@@ -121,11 +173,21 @@ def _options(args: argparse.Namespace) -> SolverOptions:
 
 
 def _write(frame, out: str | None) -> None:
+    """To standard output, or atomically: a temporary file beside ``out``, renamed over it."""
     if out is None or out == "-":
         frame.to_csv(sys.stdout, index=False)
-    else:
-        frame.to_csv(out, index=False)
-        print(f"wrote {len(frame)} rows to {out}")
+        return
+    target = Path(out)
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", newline="") as f:
+            frame.to_csv(f, index=False)
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    print(f"wrote {len(frame)} rows to {out}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -200,11 +262,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
+        # everything is checked before anything is computed
+        _check_out(args.out, "--out")
+        _check_out(getattr(args, "events", None), "--events")
+        _check_magnitudes(args)
         if args.command == "critical":
             import pandas as pd
 
-            rows = [critical_velocity(_model(args, k0)).to_frame() for k0 in args.k0]
-            frame = pd.concat(rows, ignore_index=True)
+            results = [critical_velocity(_model(args, k0)) for k0 in args.k0]
+            for r in results:
+                if r.status != "unstable band":
+                    print(f"k0={r.k0:g}: {r.status} (Vc = {r.Vc:g})", file=sys.stderr)
+            frame = pd.concat([r.to_frame() for r in results], ignore_index=True)
             _write(frame, args.out)
             return 0
         model = _model(args, args.k0)
@@ -216,8 +285,6 @@ def main(argv: Sequence[str] | None = None) -> int:
                 velocities = args.V
             else:
                 vmin, vmax, n = args.V_range
-                if not (vmin > 0 and vmax > vmin and n >= 1 and float(n).is_integer()):
-                    raise ValueError("--V-range needs 0 < VMIN < VMAX and an integer N >= 1")
                 velocities = np.geomspace(vmin, vmax, int(n))
             result = sweep(model, velocities, options=options, progress=args.verbose)
             _write(result.to_frame(), args.out)
@@ -229,8 +296,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options)
         _write(traj.to_frame(), args.out)
         if args.events:
-            traj.events_frame().to_csv(args.events, index=False)
-            print(f"wrote {len(traj.events)} events to {args.events}")
+            _write(traj.events_frame(), args.events)
         if not traj.success:
             print(f"warning: {traj.message}", file=sys.stderr)
             return 3

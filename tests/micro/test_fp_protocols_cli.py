@@ -1,6 +1,7 @@
 """Slide-hold-slide and the command line of the Fokker-Planck solver."""
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -105,3 +106,35 @@ def test_cli_run_slide_hold_slide_and_constant_velocity(tmp_path):
     exact = float(micro.steady_sliding(micro.Model(k0=0.3), 2.0, growth_rate=False).sigma)
     late = run[run.t > 2.5]
     assert abs(late.sigma.mean() - exact) < 5e-4
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["sweep", "--k0", "0.1", "--V", "0.5,,2"], r"--V item 2 of 3 must be a number"),
+    (["sweep", "--k0", "0.1", "--V", "5,nan"], r"--V item 2 must be in \[1e-06, 1e\+07\]"),
+    (["critical", "--k0", "0.1,1e400"], r"--k0 item 2 must be in \[0, 1000\]"),
+    (["steady", "--k0", "1e300", "--V", "1"], r"--k0 must be in \(0, 1000\]"),
+    (["steady", "--k0", "0.1", "--V", "1", "--out", ""], "--out must name a CSV file"),
+    (["steady", "--k0", "0.1", "--V", "1", "--out", "/proc/x.csv"], "cannot write in '/proc'"),
+    (["steady", "--k0", "0.1", "--V", "1", "--out", "/"], "is a directory"),
+    (["steady", "--k0", "0.1", "--V", "1", "--out", "/nonexistent-dir/x.csv"], "does not exist"),
+])
+def test_every_input_is_checked_before_computing(argv, match, tmp_path, capsys):
+    # each of these used to compute first (sweep --V 5,nan: 228 s) and fail on writing or on
+    # the bad item; now one line names the option, in well under a second
+    from micro.cli import main as micro_main
+
+    if "--out" not in argv:
+        argv = [*argv, "--out", str(tmp_path / "x.csv")]
+    assert micro_main(argv) == 2
+    assert re.search(match, capsys.readouterr().err)
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_critical_with_the_fp_answers_k0_above_k2_at_once(tmp_path):
+    # k0 >= k2: steady sliding is stable at every V (closed form); the bisection used to run 9+ min
+    from micro.cli import main as micro_main
+
+    out = tmp_path / "vc.csv"
+    assert micro_main(["critical", "--k0", "1.0", "--method", "fp", "--out", str(out), "-v"]) == 0
+    row = pd.read_csv(out).iloc[0]
+    assert row.status == "no stick-slip" and row.Vc == 0.0 and "k2" in row.message

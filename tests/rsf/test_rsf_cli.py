@@ -65,8 +65,15 @@ def test_run_writes_series_and_events(tmp_path):
 
 
 @pytest.mark.parametrize("argv, match", [
-    (["sweep", "--k0", "-1", "--V", "1"], "k0 must be a finite number > 0"),
-    (["sweep", "--k0", "0.1", "--V", "0"], "velocities\\[0\\] must be a finite number > 0"),
+    (["sweep", "--k0", "-1", "--V", "1"], "--k0 must be in \\(0, 1000\\]"),
+    (["sweep", "--k0", "1e300", "--V", "1"], "--k0 must be in \\(0, 1000\\]"),
+    (["sweep", "--k0", "0.1", "--V", "0"], "--V must be in \\(0, 1e\\+07\\]"),
+    (["sweep", "--k0", "0.1", "--V-range", "0.1", "1", "1e9"], "--V-range needs .* integer N in \\[1, 10000\\]"),
+    (["run", "--k0", "0.3", "--V", "1", "--t-end", "1e12", "--out", "-"], "--t-end must be in \\(0, 1e\\+08\\]"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--out", ""], "--out must name a CSV file"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--out", "/proc/x.csv"], "cannot write in '/proc'"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--out", "/"], "is a directory"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--out", "/nonexistent-dir/x.csv"], "does not exist"),
     (["sweep", "--k0", "0.1", "--Dc", "0", "--V", "1"], "Dc must be a finite number > 0"),
     (["sweep", "--k0", "0.1", "--V", "1", "--rtol", "5"], "rtol must lie in"),
     (["sweep", "--k0", "0.1", "--V", "1", "--B", "0"], "B must be a finite number > 0"),
@@ -78,6 +85,21 @@ def test_bad_input_exit_code_and_message(argv, match, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert re.search(match, err)
+
+
+@pytest.mark.parametrize("V, match", [("0.5,,2", "item 2 of 3 must be a number"), ("5,nan", "item 2 must be finite")])
+def test_list_items_are_all_checked_before_computing(V, match, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["sweep", "--k0", "0.1", "--V", V, "--out", "-"])
+    assert exc.value.code == 2 and re.search(match, capsys.readouterr().err)
+
+
+def test_critical_says_when_steady_sliding_is_stable_at_every_V(capsys):
+    assert main(["critical", "--k0", "1.0,0.1"]) == 0
+    captured = capsys.readouterr()
+    assert "k0=1: stable at every V" in captured.err
+    frame = pd.read_csv(__import__("io").StringIO(captured.out))
+    assert list(frame.status) == ["stable at every V", "unstable band"] and np.isnan(frame.Vc[0])
 
 
 def test_unconverged_sweep_exits_3(tmp_path, capsys):
