@@ -8,7 +8,6 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-from pathlib import Path
 
 from .params import SCENARIOS, Settings
 from .report import report
@@ -56,12 +55,12 @@ def main(argv: list[str] | None = None) -> int:
     try:
         factory = Settings.quick if args.quick else Settings.paper if args.paper else Settings.default
         settings = factory(**changes)
-        rep = report(settings, out=Path(args.out), Dc=args.dc, cache_dir=args.cache_dir,
+        rep = report(settings, out=args.out, Dc=args.dc, cache_dir=args.cache_dir,
                      use_cache=not args.no_cache, workers=args.workers, scheduler=args.scheduler,
                      progress=not args.no_progress)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    print(rep.summary)
-    print(f"\nwrote {rep.out} ({len(rep.tables)} tables, {len(rep.figures)} figures) in {rep.wall_time:.1f} s")
+    print(f"wrote {rep.out} ({len(rep.tables)} tables, {len(rep.figures)} figures) in {rep.wall_time:.1f} s; "
+          f"read {rep.out / 'summary.md'}")
     return 0

@@ -24,11 +24,18 @@ __all__ = ["draw"]
 _COLORS = {0.3: "C0", 0.1: "C1", 0.01: "C2", 0.001: "C3", 0.0001: "C4"}
 
 
-def _save(fig, path: Path) -> Path:
+def _save(fig, path) -> Path:
+    """Save ``fig`` as the PNG ``path``: a file name in a :class:`ReportFolder` (written
+    atomically) or a plain path."""
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    try:
+        if isinstance(path, tuple):
+            folder, name = path
+            return folder.write(name, lambda p: fig.savefig(p, dpi=110, format="png"))
+        fig.savefig(path, dpi=110)
+        return path
+    finally:
+        plt.close(fig)
 
 
 def _color(k0: float, i: int = 0) -> str:
@@ -147,9 +154,10 @@ def dc_profile(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -
         lab = f"(a) D_c = {Dc:.3g} ± {values['Dc_err']:.2g}"
     ax.axvline(Dc, color="k", lw=1, label=lab)
     ax.axvspan(lo, hi, color="k", alpha=0.1, label=f"profile interval [{lo:.3g}, {hi:.3g}]")
-    b_lo, b_hi = values["Dc_vc_range"]
-    ax.axvline(values["Dc_vc"], color="C3", lw=1, label=f"(b) V^c matching: {values['Dc_vc']:.3g}")
-    ax.axvspan(b_lo, b_hi, color="C3", alpha=0.1, label=f"(b) per-k0 range [{b_lo:.3g}, {b_hi:.3g}]")
+    if "Dc_vc" in values:  # (b) is computed by the scenarios that need V^c (not by shs alone)
+        b_lo, b_hi = values["Dc_vc_range"]
+        ax.axvline(values["Dc_vc"], color="C3", lw=1, label=f"(b) V^c matching: {values['Dc_vc']:.3g}")
+        ax.axvspan(b_lo, b_hi, color="C3", alpha=0.1, label=f"(b) per-k0 range [{b_lo:.3g}, {b_hi:.3g}]")
     ax.axvline(0.06, color="C2", ls="--", lw=0.8, label="paper D_c = 0.06")
     ax.set_xlabel("D_c")
     ax.set_ylabel("rms residual of sigma_max, sigma_min")
@@ -311,26 +319,28 @@ def fig10(t: dict[str, pd.DataFrame], path: Path) -> Path:
     return _save(fig, path)
 
 
-def draw(study, out: Path) -> dict[str, Path]:
-    """Every figure whose tables the study computed; returns name -> path."""
+def draw(study, out) -> dict[str, Path]:
+    """Every figure whose tables the study computed, into the folder ``out`` (a path or a
+    :class:`~compare.output.ReportFolder`, which writes atomically); returns name -> path."""
     t, v = study.tables, study.values
+    dest = (lambda name: (out, name)) if hasattr(out, "write") else (lambda name: Path(out) / name)  # noqa: E731
     figs: dict[str, Path] = {}
     if "rs_bifurcation" in t:
-        figs["bifurcation"] = bifurcation(t, study.Dc, study.s.fp_k0, out / "bifurcation.png")
+        figs["bifurcation"] = bifurcation(t, study.Dc, study.s.fp_k0, dest("bifurcation.png"))
     if "steady_fit_checks" in t:
-        figs["steady_fit"] = steady_fit(t, v, out / "steady_fit.png")
+        figs["steady_fit"] = steady_fit(t, v, dest("steady_fit.png"))
     if "dc_profile" in t:
-        figs["dc_profile"] = dc_profile(t, v, out / "dc_profile.png")
+        figs["dc_profile"] = dc_profile(t, v, dest("dc_profile.png"))
     if "vc_curves" in t:
-        figs["critical_velocity"] = critical_velocity(t, v, out / "critical_velocity.png")
+        figs["critical_velocity"] = critical_velocity(t, v, dest("critical_velocity.png"))
     if "hopf_points" in t:
-        figs["hopf"] = hopf(t, v, out / "hopf.png")
+        figs["hopf"] = hopf(t, v, dest("hopf.png"))
     if "phase_rs" in t and len(t["phase_laws"]):
-        figs["phase"] = phase(t, v, out / "phase.png")
+        figs["phase"] = phase(t, v, dest("phase.png"))
     if "shs_points" in t:
-        figs["shs"] = shs(t, out / "shs.png")
+        figs["shs"] = shs(t, dest("shs.png"))
     if "fig3_traces" in t:
-        figs["fig3"] = fig3(t, out / "fig3.png")
+        figs["fig3"] = fig3(t, dest("fig3.png"))
     if "fig10_eps" in t:
-        figs["fig10"] = fig10(t, out / "fig10.png")
+        figs["fig10"] = fig10(t, dest("fig10.png"))
     return figs

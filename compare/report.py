@@ -41,6 +41,7 @@ import rsf
 from . import fits
 from ._validation import positive
 from .cache import NullCache, PointCache
+from .output import ReportFolder, check_folder
 from .params import PAPER_K0, Settings
 from .rs_side import classical_rs, rs_curves, rs_hopf, rs_slide_hold_slide
 from .runner import Runner
@@ -640,6 +641,8 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
         settings = settings.with_(scenarios=tuple(scenarios))
     if Dc is not None:
         Dc = positive("Dc", Dc)
+    if out is not None:
+        check_folder(out)  # before any computation
     cache = PointCache(cache_dir) if use_cache else NullCache()
     rep = Report(settings=settings)
     with Runner(cache, workers=workers, scheduler=scheduler, progress=progress) as runner:
@@ -652,15 +655,17 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
     rep.tables, rep.values = study.tables, study.values
     rep.tables["settings"] = pd.DataFrame([{k: repr(v) if isinstance(v, tuple) else v
                                             for k, v in settings.to_dict().items()}])
+    folder = None
     if out is not None:
         from . import figures
-        rep.out = Path(out)
-        rep.out.mkdir(parents=True, exist_ok=True)
+        folder = ReportFolder(Path(out))
+        rep.out = folder.path
         for name, table in rep.tables.items():
-            table.to_csv(rep.out / f"{name}.csv", index=False)
-        rep.figures = figures.draw(study, rep.out)
+            folder.write(f"{name}.csv", lambda p, t=table: t.to_csv(p, index=False))
+        rep.figures = figures.draw(study, folder)
     rep.wall_time = time.perf_counter() - start
     rep.summary = summary(study, rep)
-    if rep.out is not None:
-        (rep.out / "summary.md").write_text(rep.summary, encoding="utf-8")
+    if folder is not None:
+        folder.write("summary.md", lambda p: p.write_text(rep.summary, encoding="utf-8"))
+        folder.finish()
     return rep

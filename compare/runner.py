@@ -97,6 +97,13 @@ class Runner:
         if scheduler is not None and not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
             raise ValueError(f"scheduler must be an address like 'tcp://host:8786' or a distributed.Client, "
                              f"got {scheduler!r}")
+        if isinstance(scheduler, str):
+            # an address needs the dask extra: say so now, not when the first task is due
+            import importlib.util
+
+            if importlib.util.find_spec("distributed") is None:
+                raise ValueError("scheduler needs the optional dependency dask.distributed: "
+                                 "pip install '.[dask]' (or 'dask[distributed]')")
         self.scheduler = scheduler
         self.progress = bool(progress)
         self.stats = RunStats()

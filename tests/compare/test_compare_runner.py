@@ -140,3 +140,47 @@ def test_dask_local_cluster_gives_the_serial_result(tmp_path):
     strip = lambda recs: [{**r, "result": {k: v for k, v in r["result"].items() if k != "wall_time"}}  # noqa: E731
                           for r in recs]
     assert _same(strip(remote), strip(serial))  # everything but the wall time
+
+
+def test_report_folder_is_checked_before_computing_and_never_left_stale(tmp_path, monkeypatch):
+    import importlib
+
+    from compare.output import MANIFEST, ReportFolder, check_folder
+
+    for bad, match in [("", "must name a folder"), (str(tmp_path / "f.txt"), "is not a folder"),
+                       ("/proc/x", "cannot write")]:
+        (tmp_path / "f.txt").write_text("x")
+        with pytest.raises(ValueError, match=match):
+            check_folder(bad)
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "summary.md").write_text("someone else's")
+    with pytest.raises(ValueError, match="no report wrote"):
+        check_folder(foreign)
+    # compare.report refuses before computing anything (with no Runner it could not compute)
+    monkeypatch.setattr(importlib.import_module("compare.report"), "Runner", None)
+    with pytest.raises(ValueError, match="no report wrote"):
+        compare.report(out=foreign)
+    assert (foreign / "summary.md").read_text() == "someone else's"
+
+    out = tmp_path / "rep"
+    first = ReportFolder(out)
+    for name in ("a.csv", "b.csv", "summary.md"):
+        first.write(name, lambda p: p.write_text("1"))
+    assert first.finish() == []
+    second = ReportFolder(out)  # a narrower report into the same folder
+    assert json.loads((out / MANIFEST).read_text())["complete"] is False  # incomplete while written
+    second.write("a.csv", lambda p: p.write_text("2"))
+    second.write("summary.md", lambda p: p.write_text("2"))
+    assert second.finish() == ["b.csv"] and not (out / "b.csv").exists()
+    assert json.loads((out / MANIFEST).read_text()) == {"complete": True, "files": ["a.csv", "summary.md"]}
+    assert sorted(p.name for p in out.iterdir()) == sorted([MANIFEST, "a.csv", "summary.md"])
+
+
+def test_scheduler_without_dask_is_a_clear_error(monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "distributed" else real(name, *a))
+    with pytest.raises(ValueError, match="scheduler needs the optional dependency"):
+        Runner(compare.NullCache(), scheduler="tcp://127.0.0.1:8786", progress=False)
