@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import sys
+import threading
 
 from .params import SCENARIOS, Settings
 from .report import report
@@ -41,8 +43,14 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _terminate(signum, frame) -> None:
+    raise KeyboardInterrupt  # SIGTERM (timeout, batch schedulers) stops like Ctrl-C
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminate)
     logging.basicConfig(level=[logging.WARNING, logging.INFO, logging.DEBUG][min(args.verbose, 2)],
                         format="%(levelname)s %(name)s: %(message)s")
     changes = {}
@@ -61,6 +69,10 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("interrupted: the finished micro points are in the cache; the same command resumes from them",
+              file=sys.stderr)
+        return 130
     print(f"wrote {rep.out} ({len(rep.tables)} tables, {len(rep.figures)} figures) in {rep.wall_time:.1f} s; "
           f"read {rep.out / 'summary.md'}")
     return 0

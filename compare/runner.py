@@ -22,6 +22,8 @@ from __future__ import annotations
 import logging
 import multiprocessing
 import os
+import signal
+import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
@@ -65,9 +67,35 @@ class RunStats:
 _BLAS_THREADS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
-def _worker_init() -> None:
-    logging.basicConfig(level=logging.WARNING)
+def _worker_init(parent_pid: int) -> None:
+    """A pool worker: Ctrl-C is the parent's to handle (it stops the pool at once), and the
+    worker dies with its parent however the parent ends (SIGKILL included)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with_parent(parent_pid)
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     warm_up()
+
+
+def _die_with_parent(parent_pid: int) -> None:
+    """On Linux the kernel sends SIGKILL when the parent dies (``prctl(PR_SET_PDEATHSIG)``);
+    elsewhere a daemon thread checks once a second that the parent is still there."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(1, int(signal.SIGKILL)) == 0:  # 1 = PR_SET_PDEATHSIG
+            if os.getppid() != parent_pid:  # the parent died before the call
+                os._exit(1)
+            return
+    except (OSError, AttributeError):
+        pass
+
+    def watch() -> None:
+        while os.getppid() == parent_pid:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="parent-watch", daemon=True).start()
 
 
 class Runner:
@@ -116,12 +144,20 @@ class Runner:
     def __enter__(self) -> Runner:
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, exc_type, *exc) -> None:
+        # on an exception (Ctrl-C, SIGTERM) the running tasks are not waited for
+        self.close(kill=exc_type is not None)
 
-    def close(self) -> None:
+    def close(self, kill: bool = False) -> None:
+        """Shut the pool down: wait for running tasks, or with ``kill`` terminate them at
+        once (their points are lost; finished ones are already in the cache)."""
         if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
+            if kill:
+                for proc in list((getattr(self._pool, "_processes", None) or {}).values()):
+                    proc.terminate()
+                self._pool.shutdown(wait=False)
+            else:
+                self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
         if self._client is not None and self._own_client:
             self._client.close()
@@ -198,7 +234,7 @@ class Runner:
             self._ensure_warm()  # compile once here; workers then load numba's disk cache
             self._pool = ProcessPoolExecutor(max_workers=self.workers,
                                              mp_context=multiprocessing.get_context("spawn"),
-                                             initializer=_worker_init)
+                                             initializer=_worker_init, initargs=(os.getpid(),))
         # one BLAS thread per worker: the workers already fill the cores, and OpenBLAS threads
         # competing with another worker's made micro's direct solver 4-8x slower (measured);
         # the spawned workers read these when they import numpy
@@ -218,8 +254,10 @@ class Runner:
                 for fut in done:
                     yield fut.result()
         except BaseException:
-            for fut in pending:
-                fut.cancel()
+            # Ctrl-C, SIGTERM or a failure: stop the pool now (its running points are lost,
+            # the finished ones are cached).  The queued futures are not cancelled one by one:
+            # the pool's manager thread fails them itself once its workers are gone.
+            self.close(kill=True)
             raise
 
     def _compute_dask(self, todo: list[Task]) -> Iterable[dict[str, Any]]:

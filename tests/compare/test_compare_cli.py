@@ -4,6 +4,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pandas as pd
@@ -87,3 +88,56 @@ def test_paper_preset_runs_a_scenario(tmp_path):
     points = pd.read_csv(out / "shs_points.csv")
     assert points.hold_time.nunique() == 9
     assert "Preset `paper`" in (out / "summary.md").read_text()
+
+
+def _children(pid: int) -> list[int]:
+    kids = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                stat = Path(f"/proc/{entry}/stat").read_text()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                kids.append(int(entry))
+    return kids
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM", "SIGKILL"])
+def test_killed_run_leaves_no_worker_behind(sig, tmp_path):
+    # what Ctrl-C, `timeout` and batch schedulers send: the pool workers (~245 MB each) used to
+    # outlive their parent for good, and Ctrl-C took 22 s and printed a 28-line traceback
+    import signal
+
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    proc = subprocess.Popen([sys.executable, "-m", "compare", "--quick", "--no-progress", "--workers", "2",
+                             "--out", str(tmp_path / "r"), "--cache-dir", str(tmp_path / "c")],
+                            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while len(_children(proc.pid)) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)
+        kids = _children(proc.pid)
+        assert len(kids) >= 2, "the pool never started"
+        start = time.monotonic()
+        proc.send_signal(getattr(signal, sig))
+        _, err = proc.communicate(timeout=30)
+        took = time.monotonic() - start
+        deadline = time.monotonic() + 10
+        while any(_alive(k) for k in kids) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not [k for k in kids if _alive(k)]
+        if sig != "SIGKILL":
+            assert proc.returncode == 130 and took < 3.0
+            assert err.strip().splitlines()[-1].startswith("interrupted:") and "Traceback" not in err
+    finally:
+        if proc.poll() is None:
+            proc.kill()
