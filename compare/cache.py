@@ -75,7 +75,7 @@ class PointCache:
         """Write ``record`` atomically; returns the final path."""
         path = self.path(key)
         path.parent.mkdir(parents=True, exist_ok=True)
-        text = json.dumps(record, sort_keys=True, allow_nan=True)
+        text = json.dumps(record, allow_nan=True)  # key order kept: CSV columns do not depend on the cache
         fd, tmp = tempfile.mkstemp(prefix=f".{key[:12]}.", suffix=".tmp", dir=path.parent)
         try:
             with os.fdopen(fd, "w", encoding="utf-8") as fh:

@@ -184,3 +184,12 @@ def test_scheduler_without_dask_is_a_clear_error(monkeypatch):
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "distributed" else real(name, *a))
     with pytest.raises(ValueError, match="scheduler needs the optional dependency"):
         Runner(compare.NullCache(), scheduler="tcp://127.0.0.1:8786", progress=False)
+
+
+def test_cached_records_keep_their_key_order(tmp_path):
+    # CSV columns come from the record's keys: a cache that sorted them reordered the
+    # columns of a resumed report
+    cache = PointCache(tmp_path)
+    record = {"key": "k" * 64, "result": {"k0": 0.1, "V": 2.0, "regime": "steady", "eps": 0.01}}
+    cache.put(record["key"], record)
+    assert list(cache.get(record["key"])["result"]) == ["k0", "V", "regime", "eps"]
