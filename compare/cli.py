@@ -11,6 +11,8 @@ import signal
 import sys
 import threading
 
+from tqdm.contrib.logging import logging_redirect_tqdm
+
 from .params import SCENARIOS, Settings
 from .report import report
 
@@ -63,9 +65,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         factory = Settings.quick if args.quick else Settings.paper if args.paper else Settings.default
         settings = factory(**changes)
-        rep = report(settings, out=args.out, Dc=args.dc, cache_dir=args.cache_dir,
-                     use_cache=not args.no_cache, workers=args.workers, scheduler=args.scheduler,
-                     progress=not args.no_progress)
+        with logging_redirect_tqdm():  # log lines above the progress bars, not glued to them
+            rep = report(settings, out=args.out, Dc=args.dc, cache_dir=args.cache_dir,
+                         use_cache=not args.no_cache, workers=args.workers, scheduler=args.scheduler,
+                         progress=not args.no_progress)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
