@@ -142,7 +142,7 @@ MAX_SHIFT = 2.0
 DT_MIN = 1e-12
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _clip01(v: float) -> float:
     if v <= 0.0:
         return 0.0
@@ -151,7 +151,7 @@ def _clip01(v: float) -> float:
     return v
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def landing_cdf(s: float, prm: np.ndarray, table: np.ndarray) -> float:
     """Cumulative distribution of the landing displacement ``s = kappa z``."""
     if s <= 0.0:
@@ -173,19 +173,19 @@ def landing_cdf(s: float, prm: np.ndarray, table: np.ndarray) -> float:
 
 
 # ------------------------------------------------------------------------ relaxation
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _target(fst, prm, x):
     """Ya(x): the relaxation target of delta_R at delta_F = x, in the frame of t_a."""
     return (prm[P_K2] / prm[P_KAPPA]) * (fst[F_SUMX] / fst[F_MASS] - x) - prm[P_K2] * (fst[F_HBAR] - fst[F_HREF])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _correction(fst, prm, y, x):
     """True minus stored delta_R of mass stored at ``y`` with delta_F ``x``."""
     return (1.0 - fst[F_LAM]) * (_target(fst, prm, x) - y) + fst[F_DRIFT]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _stored(fst, prm, y_true, x, p_lam):
     """Stored delta_R of mass that has true delta_R ``y_true`` now and jumped when the
     relaxation factor since t_a was ``p_lam``: the next synchronisation relaxes it by
@@ -195,7 +195,7 @@ def _stored(fst, prm, y_true, x, p_lam):
 
 
 # ------------------------------------------------------------------------ jumps
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def inject(M, W, O, ist, fst, prm, table, chi, clo, mass, y_true, depth, p_lam):
     """Deposit ``mass`` that jumps from delta_R = ``y_true``, ``depth`` bins below threshold.
 
@@ -304,7 +304,7 @@ def inject(M, W, O, ist, fst, prm, table, chi, clo, mass, y_true, depth, p_lam):
 
 
 # ------------------------------------------------------------------------ threshold
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def crossing_candidates(M, W, O, ist, fst, prm, clo, cand):
     """Cells that a shift of up to MAX_SHIFT bins can carry across ``delta = 0``: fills
     rows of ``cand`` with (true lower edge in bins, filled fraction, mass) and returns
@@ -335,7 +335,7 @@ def crossing_candidates(M, W, O, ist, fst, prm, clo, cand):
     return n
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _crossing(cand, n, shift):
     """Mass of the candidates below ``delta = 0`` after a shift of ``shift`` bins."""
     total = 0.0
@@ -351,7 +351,7 @@ def _crossing(cand, n, shift):
     return total
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def shift_and_jump(M, W, O, ist, fst, prm, table, chi, clo, shift, ex_m, ex_y, ex_d, p_lam):
     """Shift every delta_F down by ``shift`` bins and make the mass that crosses jump.
 
@@ -416,7 +416,7 @@ def shift_and_jump(M, W, O, ist, fst, prm, table, chi, clo, shift, ex_m, ex_y, e
     return inject_exits(M, W, O, ist, fst, prm, table, chi, clo, ex_m, ex_y, ex_d, p_lam)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def inject_exits(M, W, O, ist, fst, prm, table, chi, clo, ex_m, ex_y, ex_d, p_lam):
     """Land the exits collected per row in ``ex_*``; rows whose landing fits are cleared.
     Returns ``(jumped, moment)``, or ``(-1 or -2, moment so far)`` if some landing did
@@ -442,7 +442,7 @@ def inject_exits(M, W, O, ist, fst, prm, table, chi, clo, ex_m, ex_y, ex_d, p_la
     return jumped, moment
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _apply_jumps(fst, prm, jumped, moment):
     """Account for jumps that moved sum(M * delta_F) by ``moment``: hbar moves by
     ``moment / kappa``, the stress drops by ``k0`` times that and every delta_F owes a
@@ -455,7 +455,7 @@ def _apply_jumps(fst, prm, jumped, moment):
     return (prm[P_K1] + prm[P_K2]) * dh / prm[P_EPS]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, tol, ex_m, ex_y, ex_d, p_lam, cand, max_iter):
     """Apply ``owed`` bins of shift and the stress redistribution it triggers.
 
@@ -504,7 +504,7 @@ def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, tol, ex_m, ex_y, e
 
 
 # ------------------------------------------------------------------------ synchronisation
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def synchronise(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_n, ex_m, ex_y, ex_d):
     """Move every cell to its true delta_R (exact relaxation since t_a) and reset t_a.
 
@@ -631,7 +631,7 @@ def synchronise(M, W, O, Mn, Wn, On, ist, fst, prm, table, chi, clo, chi_n, clo_
     return jumped, moment, DONE
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def bounds(ist, fst, prm, clo, chi):
     """Rows and columns that the true positions, or a full relaxation from them, can
     reach: ``(rmin, rmax, cmax)``."""
@@ -661,7 +661,7 @@ def bounds(ist, fst, prm, clo, chi):
 
 
 # ------------------------------------------------------------------------ records
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _record(rec, ist, fst, t, sigma):
     """Write one record (the window since the previous record) and open a new window."""
     n = ist[I_NREC]
@@ -680,7 +680,7 @@ def _record(rec, ist, fst, t, sigma):
 
 
 # ------------------------------------------------------------------------ the loop
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def advance(bufM, bufW, bufO, bufchi, bufclo, ist, fst, prm, table, ex_m, ex_y, ex_d, cand,
             velocity, t_stop, max_steps, cols_needed, rec, rec_dt, shocks, stop_shocks):
     """Advance the density from ``fst[F_T]`` to ``t_stop`` at drive velocity ``velocity``.

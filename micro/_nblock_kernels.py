@@ -91,7 +91,7 @@ _TWO_M53 = 1.0 / 9007199254740992.0
 
 
 # ---- random pinning landscape ------------------------------------------------------------
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def mix64(z):
     """splitmix64 finaliser of an unsigned 64-bit integer."""
     z = (z ^ (z >> _S30)) * _M1
@@ -99,7 +99,7 @@ def mix64(z):
     return z ^ (z >> _S31)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def hash_uniform(seed, block, count):
     """A uniform number in (0, 1) fixed by (seed, block, count): the ``count``-th well of ``block``.
 
@@ -111,7 +111,7 @@ def hash_uniform(seed, block, count):
     return (float(k >> _S11) + 0.5) * _TWO_M53
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def draw_distance(par, qtab_u, qtab_z, seed, block, count):
     """The distance to the next pinning well of ``block`` at its ``count``-th jump."""
     u = hash_uniform(seed, block, count)
@@ -124,7 +124,7 @@ def draw_distance(par, qtab_u, qtab_z, seed, block, count):
 
 
 # ---- one block between events ----------------------------------------------------------
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def first_crossing(alpha, beta, gamma, drive, tau_max):
     """First root in [0, tau_max] of f(tau) = alpha + beta exp(-gamma tau) - drive tau.
 
@@ -163,7 +163,7 @@ def first_crossing(alpha, beta, gamma, drive, tau_max):
 
 
 # ---- kinetic tournament tree -------------------------------------------------------------
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def tree_recompute(v, win, tree, x):
     """Recompute internal node v from its two children at the current x.
 
@@ -212,7 +212,7 @@ def tree_recompute(v, win, tree, x):
     tree[v, T_MXC] = m
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def tree_set_leaf(i, a_i, b_i, n_leaves, win, tree, x):
     """Give block i the line a_i + b_i x and repair the path to the root."""
     v = n_leaves + i
@@ -224,7 +224,7 @@ def tree_set_leaf(i, a_i, b_i, n_leaves, win, tree, x):
         v >>= 1
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def tree_build(h, s_coef, par, n_leaves, win, tree, x):
     """Fill the leaves with the blocks' lines and build every internal node at x."""
     n = h.shape[0]
@@ -246,7 +246,7 @@ def tree_build(h, s_coef, par, n_leaves, win, tree, x):
         tree_recompute(v, win, tree, x)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def tree_process_swaps(win, tree, x, n_leaves):
     """Repair every node whose certificate has failed (certificate >= x), deepest first."""
     count = 0
@@ -267,7 +267,7 @@ def tree_process_swaps(win, tree, x, n_leaves):
 
 
 # ---- global bookkeeping ------------------------------------------------------------------
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def phi(fs, par):
     """The common part of delta: Phi = k0 w + (k1 + k2) hbar - k2 m - f_th."""
     return (
@@ -278,7 +278,7 @@ def phi(fs, par):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def advance(fs, par, velocity, t_new):
     """Drive and relax from fs[F_T] to t_new with hbar fixed; return the integral of sigma."""
     dt = t_new - fs[F_T]
@@ -294,7 +294,7 @@ def advance(fs, par, velocity, t_new):
     return integral
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def rebase(fs, par, h, s_coef, n_leaves, win, tree):
     """Reset x to 1 and move the origin of positions to hbar (O(N), rare).
 
@@ -321,7 +321,7 @@ def rebase(fs, par, h, s_coef, n_leaves, win, tree):
     tree_build(h, s_coef, par, n_leaves, win, tree, 1.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def avalanche(
     trigger, fs, par, h, s_coef, n_jumps, seed, qtab_u, qtab_z, n_leaves, win, tree, max_jumps, counters
 ):
@@ -360,7 +360,7 @@ def avalanche(
 
 
 # ---- the event loop ------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def run_events(
     par,
     fs,

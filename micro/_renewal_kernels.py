@@ -21,7 +21,7 @@ from numba import njit
 MAX_NEWTON = 80
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def waiting_time(zeta: float, D: float, alpha: float, beta: float) -> float:
     """Root t > 0 of ``alpha t + beta D (1 - e^-t) = zeta``: the time to the next jump.
 
@@ -58,7 +58,7 @@ def waiting_time(zeta: float, D: float, alpha: float, beta: float) -> float:
     return t
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def phi2(t: float) -> float:
     """``(t - 1 + e^-t) / t^2`` without cancellation (a series below t = 0.1)."""
     if t < 0.1:
@@ -73,14 +73,14 @@ def phi2(t: float) -> float:
     return (t + math.expm1(-t)) / (t * t)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def margin_integral(zeta: float, D: float, t: float, alpha: float, beta: float) -> float:
     """Integral of the margin from a jump to the next, ``zeta t - alpha t^2/2 - beta D
     (t - 1 + e^-t)``: a positive integrand, written without cancellation."""
     return t * (zeta - 0.5 * alpha * t - beta * D * t * phi2(t))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def displacement(x: float, zeta: float, t: float, alpha: float) -> float:
     """``x' - x`` without cancellation.  From the waiting-time equation,
     ``x' - x = alpha (t - D (1 - e^-t)) = alpha (t (1 - D) + D (t - 1 + e^-t))``, whose terms
@@ -92,7 +92,7 @@ def displacement(x: float, zeta: float, t: float, alpha: float) -> float:
     return alpha * (t * ((1.0 - x) - zeta) + D * t * t * phi2(t))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def asinh_difference(a: float, b: float, eps: float) -> float:
     """``asinh(a) - asinh(b)`` for ``a = b + eps`` with eps known accurately."""
     if b < 0.0:
@@ -101,7 +101,7 @@ def asinh_difference(a: float, b: float, eps: float) -> float:
     return math.log1p(eps * (1.0 + (a + b) / (sa + sb)) / (b + sb))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def theta_offset(x: float, dx: float, c: float, w: float, mu: float, nu: float) -> float:
     """``theta(x + dx) - theta(x)`` with the relative accuracy of dx."""
     if not math.isfinite(w):
@@ -109,7 +109,7 @@ def theta_offset(x: float, dx: float, c: float, w: float, mu: float, nu: float) 
     return asinh_difference((x + dx - c) / w, (x - c) / w, dx / w) / nu
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def lagrange_row(i: int, offset: float, nodes: np.ndarray, bw: np.ndarray, out: np.ndarray) -> None:
     """``out[j] = l_j(nodes[i] + offset)``, the Lagrange basis on ``nodes`` (barycentric
     form), with the distances to the nodes taken as ``offset + (nodes[i] - nodes[k])`` so
@@ -130,7 +130,7 @@ def lagrange_row(i: int, offset: float, nodes: np.ndarray, bw: np.ndarray, out: 
         out[k] /= total
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def assemble(xn, thn, bw, zeta, wz, alpha, beta, c, w, mu, nu, store):
     """The chain on the collocation grid.
 

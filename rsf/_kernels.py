@@ -63,14 +63,14 @@ FLOOR = 4         # the slip ended below the resolved range of theta (theta_floo
 # --------------------------------------------------------------------------------------
 # steady-state laws: (v, p) -> (mu_ss, W)
 # --------------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def hyperbolic_law(v, p):
     r"""Eq. (10): :math:`\mu_{ss} - \mu_\infty = A/(v + B)`, ``p = [A, B]``."""
     d = v + p[1]
     return p[0] / d, p[0] * (v / d) / d
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def viscoelastic_law(v, p):
     r"""Eq. (4): :math:`\mu_{ss} - \mu_{ss}(\infty) = \bar z k_2\,(1/2 - h(y))` with
     :math:`y = \bar z k_2/(v\eta_u)` and :math:`h(y) = 1/y - 1/(e^y - 1)`;
@@ -95,7 +95,7 @@ def viscoelastic_law(v, p):
     return c * ex, c * w
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def log_law(v, p):
     r"""Eq. (9): :math:`\mu_{ss} - \mu_0 = (a - b)\ln(v/v_0)`, ``p = [a - b, v0]``."""
     if v <= 0.0:
@@ -103,7 +103,7 @@ def log_law(v, p):
     return p[0] * math.log(v / p[1]), -p[0]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def table_law(v, p):
     r"""Monotone cubic Hermite (PCHIP) interpolation of :math:`\mu_{ss}` in :math:`\ln v`,
     constant outside the data.  ``p = [n, x_0..x_{n-1}, y_0.., d_0..]`` with
@@ -141,7 +141,7 @@ def table_law(v, p):
     return y, -dydx
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def law_eval(v, p):
     """Evaluate the law coded in ``p[0]`` with parameters ``p[1:]``: (mu_ss - mu_ref, W)."""
     kind = int(p[0])
@@ -160,14 +160,14 @@ def law_eval(v, p):
 # --------------------------------------------------------------------------------------
 # the friction phi(theta) and accurate differences of it
 # --------------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def phi_w(p, theta, Dc):
     r"""Return :math:`\phi(\theta) = \mu_{ss}(D_c/\theta)` (Eq. 11, relative to ``mu_ref``)
     and :math:`W(D_c/\theta)`."""
     return law_eval(Dc / theta, p)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def dphi(p, theta_a, log_ratio, Dc):
     r"""Return :math:`\phi(\theta_a e^{r}) - \phi(\theta_a)` for ``r = log_ratio``.
 
@@ -186,7 +186,7 @@ def dphi(p, theta_a, log_ratio, Dc):
     return law_eval(Dc / (theta_a * math.exp(log_ratio)), p)[0] - law_eval(Dc / theta_a, p)[0]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def phase_fn(kind, p, x, c):
     r"""The scalar functions whose first root ends a stick (``kind = 0``) or a slip
     (``kind = 1``).
@@ -204,7 +204,7 @@ def phase_fn(kind, p, x, c):
     return c[0] - c[2] * x - dphi(p, c[1], -x, c[3])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def phase_dfn(kind, p, x, c):
     """Derivative of :func:`phase_fn` with respect to ``x``."""
     if kind == 0:
@@ -213,7 +213,7 @@ def phase_dfn(kind, p, x, c):
     return -c[2] + law_eval(c[3] * math.exp(x) / c[1], p)[1]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def brentq(kind, p, c, xa, xb, fa, fb):
     """Brent's method (the algorithm of scipy's ``brentq``) on :func:`phase_fn` over a
     bracket with ``fa * fb <= 0``; returns the root to about machine precision."""
@@ -279,7 +279,7 @@ def brentq(kind, p, c, xa, xb, fa, fb):
 # --------------------------------------------------------------------------------------
 # the stick and slip roots
 # --------------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def first_root(kind, p, c, x, x_max, k0V, w_neg, lipschitz):
     r"""March from ``x`` (where the phase function has not yet crossed) to its first
     crossing, and refine it with :func:`brentq`.
@@ -347,7 +347,7 @@ def first_root(kind, p, c, x, x_max, k0V, w_neg, lipschitz):
     return x, FAILED
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg, concave_sup):
     r"""First time :math:`t \in (0, t_{max}]` at which a stick started at
     :math:`(\sigma_0, \theta_0)` reaches the threshold, :math:`\sigma_0 + k_0 V t = \phi(\theta_0 + t)`
@@ -402,7 +402,7 @@ def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg, concave_sup):
     return first_root(0, p, c, t, t_max, k0V, w_neg, 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def slip_end(p, g0, theta0, K, Dc, lipschitz, theta_floor):
     r"""First root :math:`s > 0` of the slip function :math:`g(s)` of :func:`phase_fn`:
     the instantaneous slip :math:`\Delta x = D_c s` with :math:`\theta = \theta_0 e^{-s}` and
@@ -445,7 +445,7 @@ def slip_end(p, g0, theta0, K, Dc, lipschitz, theta_floor):
     return s, flag
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def decide(p, theta, K, V, Dc):
     r"""The phase that follows a point on the threshold :math:`\sigma = \phi(\theta)`.
 
@@ -484,7 +484,7 @@ def decide(p, theta, K, V, Dc):
     return SLIDE
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def slide_converges(p, u_s, V, K):
     r"""Whether a slide started at state velocity ``u_s`` certainly converges to steady
     sliding at ``V`` without an event.
@@ -526,7 +526,7 @@ def slide_converges(p, u_s, V, K):
 # --------------------------------------------------------------------------------------
 # the slide: CVODE right-hand side and events in the desingularised time tau
 # --------------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def slide_rhs(y, yp, p, c):
     r"""Reduced slide ODE in the time :math:`\tau` with :math:`\mathrm{d}t = D_c D/(K v_s)\,\mathrm{d}\tau`.
 
@@ -544,7 +544,7 @@ def slide_rhs(y, yp, p, c):
     yp[2] = mu * dt
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def slide_events(y, e, p, c):
     """Slide events: ``e[0]`` D (slide -> slip), ``e[1]`` N (v -> 0, slide -> stick),
     ``e[2]`` |ln(u/V)| - s_tol (steady), ``e[3]`` W (interior extremum of sigma),
@@ -575,7 +575,7 @@ def slide_events(y, e, p, c):
 # --------------------------------------------------------------------------------------
 # a > 0: the regular rate-and-state ODE
 # --------------------------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def rs_rhs(y, yp, p, c):
     r"""Spring-slider with a direct effect :math:`a > 0`:
     :math:`\sigma = \mu_{ss}(u) + a\ln(v/u)` with :math:`u = D_c/\theta`.
@@ -621,7 +621,7 @@ def rs_rhs(y, yp, p, c):
     yp[4] = dt
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def rs_events(y, e, p, c):
     """Events of the a > 0 ODE: ``e[0]`` and ``e[1]`` ln(v/V) (sigma maximum when rising,
     minimum when falling), ``e[2]`` distance to the steady state minus s_tol, ``e[3]``

@@ -121,3 +121,18 @@ def test_a_global_shock_at_small_k0_runs_in_a_small_grid():
 def test_memory_limit_is_validated(bad):
     with pytest.raises(ValueError, match="max_memory_gib"):
         micro.Numerics(max_memory_gib=bad)
+
+
+def test_every_compiled_kernel_releases_the_gil():
+    # a dask worker runs tasks in threads: a kernel holding the GIL froze its event loop
+    # for 8-11 s ("event loop unresponsive")
+    import importlib
+
+    from numba.core.registry import CPUDispatcher
+
+    for name in ("micro._kernels", "micro._nblock_kernels", "micro._renewal_kernels", "rsf._kernels"):
+        module = importlib.import_module(name)
+        kernels = [f for f in vars(module).values() if isinstance(f, CPUDispatcher)]
+        assert kernels, name
+        for f in kernels:
+            assert f.targetoptions.get("nogil") is True, f"{name}.{f.__name__}"
