@@ -625,7 +625,8 @@ def rs_rhs(y, yp, p, c):
 def rs_events(y, e, p, c):
     """Events of the a > 0 ODE: ``e[0]`` and ``e[1]`` ln(v/V) (sigma maximum when rising,
     minimum when falling), ``e[2]`` distance to the steady state minus s_tol, ``e[3]``
-    t - t_stop.  ``c[6:11] = [ln(V/v_s), ln(v_s/V), s_tol, steady_on, t_stop]``."""
+    t - t_stop, ``e[4]`` ln(v/v_max) (runaway).
+    ``c[6:12] = [ln(V/v_s), ln(v_s/V), s_tol, steady_on, t_stop, ln(v_max/v_s)]``."""
     if c[1] > 0.0:
         e[0] = y[0] - c[6]
         e[1] = e[0]
@@ -638,6 +639,7 @@ def rs_events(y, e, p, c):
         e[1] = 1.0
         e[2] = 1.0
     e[3] = y[4] - c[10]
+    e[4] = y[0] - c[11]
 
 
 # --------------------------------------------------------------------------------------

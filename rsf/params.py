@@ -197,13 +197,26 @@ class InitialState:
     sigma : float or None
         Spring force (for :math:`a = 0`: must be finite; above the threshold the run starts
         with a slip).
-    perturbation : float
-        Relative offset of the default theta from steady state, > -1 (default 1e-3).
+    perturbation : float or None
+        Relative offset of the default theta from steady state, > -1.  ``None`` (default):
+        0 (the exact steady state) for :func:`~rsf.simulate` with a velocity-step,
+        slide-hold-slide or sampled protocol, 1e-3 for constant driving and for the
+        limit-cycle searches (:func:`~rsf.limit_cycle`, :func:`~rsf.sweep`), where the
+        perturbation lets an unstable steady state depart.
     """
 
     theta: float | None = None
     sigma: float | None = None
-    perturbation: float = 1e-3
+    perturbation: float | None = None
+
+    #: The perturbation used when none is given and the run looks for an attractor.
+    DEFAULT_PERTURBATION = 1e-3
+
+    def resolved(self, perturbation: float) -> "InitialState":
+        """A copy with ``perturbation`` set to the given default if it is None."""
+        if self.perturbation is not None:
+            return self
+        return InitialState(theta=self.theta, sigma=self.sigma, perturbation=perturbation)
 
     def __post_init__(self) -> None:
         if self.theta is not None:
@@ -213,6 +226,8 @@ class InitialState:
             if not math.isfinite(s):
                 raise ValueError(f"sigma must be a finite number, got {self.sigma!r}")
             object.__setattr__(self, "sigma", s)
+        if self.perturbation is None:
+            return
         pert = float(self.perturbation)
         if not (math.isfinite(pert) and pert > -1.0):
             raise ValueError(f"perturbation must be a finite number > -1, got {self.perturbation!r}")
@@ -246,6 +261,18 @@ class SolverOptions:
         CVODE method for the slide phases (default 'Adams'; the a > 0 ODE always uses BDF).
     max_num_steps : int
         CVODE steps allowed per output interval (default 1,000,000).
+    v_max : float or None
+        Runaway bound (:math:`a > 0`): a run stops with status ``RUNAWAY`` as soon as the
+        slip velocity passes ``v_max``.  ``None`` (default): :math:`10^3 \max V` (the
+        largest load-point velocity of the protocol) when the model has a
+        :class:`~rsf.laws.LogLaw` (classical rate and state, where a slip this fast
+        without radiation damping is a finite-time blow-up), no bound for the other laws
+        (their weakening vanishes at high speed and slips at :math:`v/V \sim 10^{50}`
+        still arrest).  Give ``math.inf`` to switch the bound off.
+    max_rhs_evals : int
+        Step budget: a run (one :func:`~rsf.simulate` or :func:`~rsf.limit_cycle` call)
+        stops with status ``STEP_BUDGET`` after this many right-hand-side evaluations of
+        CVODE in total (default 20,000,000, minutes of run time), so that no input hangs.
     """
 
     rtol: float = 1e-10
@@ -256,6 +283,8 @@ class SolverOptions:
     accelerate: bool = True
     method: str = "Adams"
     max_num_steps: int = 1_000_000
+    v_max: float | None = None
+    max_rhs_evals: int = 20_000_000
 
     def __post_init__(self) -> None:
         from ._validation import in_range
@@ -269,3 +298,17 @@ class SolverOptions:
         if not isinstance(self.accelerate, bool):
             raise ValueError(f"accelerate must be True or False, got {self.accelerate!r}")
         choice("method", self.method, ("Adams", "BDF"))
+        if self.v_max is not None:
+            v_max = _as_positive_or_inf("v_max", self.v_max)
+            object.__setattr__(self, "v_max", v_max)
+        object.__setattr__(self, "max_rhs_evals", positive_int("max_rhs_evals", self.max_rhs_evals))
+
+
+def _as_positive_or_inf(name: str, value: object) -> float:
+    try:
+        result = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number > 0 (or inf), got {value!r}") from None
+    if not result > 0.0:   # also rejects nan
+        raise ValueError(f"{name} must be a number > 0 (or inf), got {value!r}")
+    return result
