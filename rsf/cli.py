@@ -146,6 +146,13 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--max-cycles", type=int, default=20000, help="give up after this many cycles")
     g.add_argument("--no-accelerate", action="store_true",
                    help="simulate every cycle of the transient (no Aitken extrapolation)")
+    g.add_argument("--v-max", type=float, default=None,
+                   help="runaway bound on the slip velocity (a > 0): stop with status RUNAWAY "
+                        "when v passes it (default 1e3 x max V for the log law, none otherwise; "
+                        "inf: off)")
+    g.add_argument("--max-rhs-evals", type=int, default=20_000_000,
+                   help="step budget: stop after this many right-hand-side evaluations "
+                        "(default 20000000)")
 
 
 def _law(args: argparse.Namespace, k0: float):
@@ -169,7 +176,8 @@ def _model(args: argparse.Namespace, k0: float) -> SpringSlider:
 
 def _options(args: argparse.Namespace) -> SolverOptions:
     return SolverOptions(rtol=args.rtol, atol=args.atol, cycle_rtol=args.cycle_rtol,
-                         max_cycles=args.max_cycles, accelerate=not args.no_accelerate)
+                         max_cycles=args.max_cycles, accelerate=not args.no_accelerate,
+                         v_max=args.v_max, max_rhs_evals=args.max_rhs_evals)
 
 
 def _write(frame, out: str | None) -> None:
@@ -230,6 +238,11 @@ def build_parser() -> argparse.ArgumentParser:
     pr.add_argument("--t-end", type=float, required=True, help="end time > 0")
     pr.add_argument("--out", required=True, help="output CSV for the time series")
     pr.add_argument("--events", default=None, help="output CSV for the events t, kind, sigma, theta, x")
+    pr.add_argument("--t-eval", type=_floats, default=None,
+                    help="output times t1,t2,... (strictly increasing, in [0, t-end]): samples "
+                         "exactly there instead of at every integrator step")
+    pr.add_argument("--t-eval-n", type=int, default=None,
+                    help="output at N equally spaced times from 0 to t-end")
     _add_model_options(pr)
     _add_solver_options(pr)
     return parser
@@ -293,7 +306,15 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return 3
             return 0
         V, protocol = _protocol(args)
-        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options)
+        if args.t_eval is not None and args.t_eval_n is not None:
+            raise ValueError("give at most one of --t-eval and --t-eval-n")
+        t_eval = args.t_eval
+        if args.t_eval_n is not None:
+            if not 2 <= args.t_eval_n <= 10_000_000:
+                raise ValueError(f"--t-eval-n must lie in [2, 10000000], got {args.t_eval_n}")
+            t_eval = np.linspace(0.0, args.t_end, args.t_eval_n)
+        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
+                        t_eval=t_eval)
         _write(traj.to_frame(), args.out)
         if args.events:
             _write(traj.events_frame(), args.events)
