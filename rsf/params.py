@@ -21,6 +21,7 @@ import numpy as np
 
 from ._validation import choice, nonnegative, positive, positive_int
 from .laws import PAPER_DC, HyperbolicLaw, LogLaw, SteadyStateLaw
+from .state_laws import AgingLaw, NagataLaw, PRZLaw, SecondState, SlipLaw, state_law_from
 
 __all__ = ["SpringSlider", "Protocol", "InitialState", "SolverOptions", "standard_rs"]
 
@@ -44,17 +45,30 @@ class SpringSlider:
         :class:`~rsf.laws.LogLaw` (Eq. 7), otherwise 0 (the paper's model, Eq. 11).
         With :math:`a = 0` the motion splits into stick, slide and instantaneous slip; with
         :math:`a > 0` it is a regular ODE.
-    state_law : {'aging', 'slip'}
-        Eq. (8) (Dieterich aging) or the Ruina slip law
-        :math:`\dot\theta = -(\theta v/D_c)\ln(\theta v/D_c)`; the slip law needs
-        :math:`a > 0` (with :math:`a = 0` the instantaneous slip is undefined for it).
+    state_law : {'aging', 'slip', 'prz', 'nagata'}, StateLaw or callable
+        The state evolution (:mod:`rsf.state_laws`): Eq. (8) (Dieterich aging), the Ruina
+        slip law :math:`\dot\theta = -(\theta v/D_c)\ln(\theta v/D_c)`,
+        Perrin-Rice-Zheng, Nagata, or a callable ``f(v, theta) -> dtheta/dt``.  All but
+        the aging law need :math:`a > 0` (with :math:`a = 0` the instantaneous slip is
+        defined for the aging law only).  ``model.state`` is the resolved
+        :class:`~rsf.state_laws.StateLaw`.
+    second_state : SecondState or None
+        A second state variable :math:`b_2\ln(v_0\theta_2/D_{c2})` (log law, a > 0; the
+        aging, slip or PRZ law).
+    eta_rad : float
+        Radiation damping :math:`\eta_{rad} \ge 0` (QDYN's quasi-dynamic term; needs
+        :math:`a > 0`): the force balance reads
+        :math:`k_0(X(t) - x) = \mu(v, \theta) + \eta_{rad}\,v` (with :math:`F_N = 1`).
+        Default 0, the paper's model.
     """
 
     law: SteadyStateLaw = field(default_factory=HyperbolicLaw)
     k0: float = 0.01
     Dc: float = PAPER_DC
     a: float | None = None
-    state_law: str = "aging"
+    state_law: object = "aging"
+    second_state: SecondState | None = None
+    eta_rad: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.law, SteadyStateLaw):
@@ -68,10 +82,30 @@ class SpringSlider:
         if a is None:
             a = self.law.a if isinstance(self.law, LogLaw) else 0.0
         object.__setattr__(self, "a", nonnegative("a", a))
-        choice("state_law", self.state_law, ("aging", "slip"))
-        if self.state_law == "slip" and self.a == 0.0:
-            raise ValueError("state_law='slip' needs a direct effect a > 0 (with a = 0 the "
-                             "instantaneous slip of the slip law is undefined); got a = 0")
+        state = state_law_from(self.state_law)
+        object.__setattr__(self, "state", state)
+        if isinstance(self.state_law, str):
+            pass
+        elif isinstance(state, (AgingLaw, SlipLaw, PRZLaw)) and state == type(state)():
+            object.__setattr__(self, "state_law", state.name)
+        if state.code != AgingLaw.code and self.a == 0.0:
+            raise ValueError(f"state_law={state.name!r} needs a direct effect a > 0 (with a = 0 "
+                             f"the instantaneous slip is defined for the aging law only); got a = 0")
+        if isinstance(state, NagataLaw) and state.b is None and not isinstance(self.law, LogLaw):
+            raise ValueError("NagataLaw(b=None) takes b from a LogLaw; give NagataLaw(c, b=...) "
+                             "for another steady-state law")
+        eta = nonnegative("eta_rad", self.eta_rad)
+        object.__setattr__(self, "eta_rad", eta)
+        if eta > 0.0 and self.a == 0.0:
+            raise ValueError("eta_rad > 0 needs a direct effect a > 0; got a = 0")
+        if self.second_state is not None:
+            if not isinstance(self.second_state, SecondState):
+                raise ValueError(f"second_state must be an rsf.SecondState, got {self.second_state!r}")
+            if not isinstance(self.law, LogLaw) or self.a == 0.0:
+                raise ValueError("second_state needs the log law (LogLaw) and a direct effect a > 0")
+            if state.code not in (AgingLaw.code, SlipLaw.code, PRZLaw.code):
+                raise ValueError(f"second_state works with the aging, slip or PRZ law, "
+                                 f"not {state.name!r}")
 
     @property
     def K(self) -> float:
@@ -85,22 +119,29 @@ class SpringSlider:
 
     def describe(self) -> dict[str, float | str]:
         """Parameters as a flat dict (for tables)."""
-        out: dict[str, float | str] = {"k0": self.k0, "Dc": self.Dc, "a": self.a,
-                                       "state_law": self.state_law}
+        out: dict[str, float | str] = {"k0": self.k0, "Dc": self.Dc, "a": self.a}
+        out.update(self.state.describe())
+        if self.second_state is not None:
+            out.update(b2=self.second_state.b2, Dc2=self.second_state.Dc2)
+        if self.eta_rad > 0.0:
+            out["eta_rad"] = self.eta_rad
         out.update(self.law.describe())
         return out
 
 
 def standard_rs(mu0: float = 0.6, a: float = 0.01, b: float = 0.015, Dc: float = 1e-5,
-                k0: float = 1e3, v0: float = 1e-6, state_law: str = "aging") -> SpringSlider:
-    r"""The classic rate-and-state spring-slider (Eq. 7 with Eq. 8 or the slip law):
+                k0: float = 1e3, v0: float = 1e-6, state_law: object = "aging",
+                second_state: SecondState | None = None, eta_rad: float = 0.0) -> SpringSlider:
+    r"""The classic rate-and-state spring-slider (Eq. 7 with a state law of
+    :mod:`rsf.state_laws`):
 
-    .. math:: \mu = \mu_0 + a\ln(v/v_0) + b\ln(\theta v_0/D_c).
+    .. math:: \mu = \mu_0 + a\ln(v/v_0) + b\ln(\theta v_0/D_c)
+              \;[+\, b_2\ln(\theta_2 v_0/D_{c2})].
 
     Defaults are laboratory-like (SI units: m, s), as in rsfmodel's examples.
     """
     return SpringSlider(law=LogLaw(mu0=mu0, a=a, b=b, v0=v0), k0=k0, Dc=Dc, a=a,
-                        state_law=state_law)
+                        state_law=state_law, second_state=second_state, eta_rad=eta_rad)
 
 
 @dataclass(frozen=True, eq=False)

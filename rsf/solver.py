@@ -34,6 +34,7 @@ from . import _kernels
 from ._sundials import OdeSolution, integrate, integrate_outputs
 from ._validation import positive
 from .laws import LogLaw
+from .state_laws import NAGATA, USER
 from .params import InitialState, Protocol, SolverOptions, SpringSlider
 from .results import STATUS_MESSAGES, CycleResult, Event, Status, SweepResult, Trajectory
 
@@ -456,13 +457,14 @@ class _PhaseEngine:
 # a > 0: the regular rate-and-state ODE
 # ======================================================================================
 class _SmoothEngine:
-    """CVODE (BDF) on ``y = [ln v, ln(theta/Dc), x, int (sigma - mu_ref) dt, t]`` for a > 0,
-    in the slip-regularised variable s of :func:`rsf._kernels.rs_rhs`.
+    """CVODE (BDF) on ``y = [ln v, ln(theta/Dc), x, int (sigma - mu_ref) dt, t
+    (, ln(theta2/Dc2))]`` for a > 0, in the slip-regularised variable s of
+    :func:`rsf._kernels.rs_rhs_dr`.
 
     With ``t_eval`` the engine records samples only at those times: CVODE's root finder
-    stops at each of them (:func:`rsf._kernels.output_event`) and returns its own
-    interpolant there, which one Newton correction along the flow moves exactly onto the
-    requested time.
+    stops at each of them (an output event in :func:`rsf._sundials.integrate_outputs`) and
+    returns its own interpolant there, which one Newton correction along the flow moves
+    exactly onto the requested time.
     """
 
     def __init__(self, model: SpringSlider, protocol: Protocol, options: SolverOptions,
@@ -478,10 +480,21 @@ class _SmoothEngine:
         self.law_fn = self.k.law_eval
         self.samples = _Samples()
         self.events: list[Event] = []
-        self.y = np.zeros(5)
+        self.second = model.second_state
+        self.n_vars = 5 if self.second is None else 6
+        self.y = np.zeros(self.n_vars)
         self.nfev = 0
         self.at_root = False       # the state sits on an event root (after a terminal event)
         self.t_eval = t_eval
+        self.eta = model.eta_rad
+        state = model.state
+        self.state_code = float(state.code)
+        self.user_rate = state.func if state.code == USER else None
+        self.c_over_b = 0.0
+        if state.code == NAGATA:
+            b = state.b if state.b is not None else model.law.b
+            self.c_over_b = state.c / b
+        self.ln_v0 = math.log(model.law.v0) if isinstance(model.law, LogLaw) else 0.0
         self.next_out = 0          # index of the next t_eval point to output
         self.v_max = _runaway_bound(model, protocol, options)
         # extrema of sigma closer than this (in ln theta) to the steady state are round-off
@@ -497,8 +510,19 @@ class _SmoothEngine:
         return float(self.y[3]) + self.mu_ref * float(self.y[4])
 
     def sigma_of(self, y: np.ndarray) -> float:
+        """The friction mu (the spring force is mu + eta_rad v)."""
         u = math.exp(-y[1])
-        return self.mu_ref + float(self.law_fn(u, self.p)[0]) + self.model.a * (y[0] + y[1])
+        out = self.mu_ref + float(self.law_fn(u, self.p)[0]) + self.model.a * (y[0] + y[1])
+        if self.second is not None:
+            out += self.second.b2 * (y[5] + self.ln_v0)
+        return out
+
+    def spring_of(self, y: np.ndarray) -> float:
+        """The spring force k0 (X - x) = mu + eta_rad v."""
+        out = self.sigma_of(y)
+        if self.eta > 0.0:
+            out += self.eta * math.exp(y[0])
+        return out
 
     def theta_of(self, y: np.ndarray) -> float:
         return self.model.Dc * math.exp(y[1])
@@ -525,10 +549,17 @@ class _SmoothEngine:
             lv = math.log(V0)
         else:
             lv = math.log(u) + (initial.sigma - self.mu_ref - float(self.law_fn(u, self.p)[0])) / m.a
-        self.y = np.array([lv, math.log(theta / m.Dc), 0.0, 0.0, 0.0])
+        self.y = np.zeros(self.n_vars)
+        self.y[:2] = [lv, math.log(theta / m.Dc)]
+        if self.second is not None:           # theta2 at steady state for the same ratio
+            self.y[5] = self.y[1]
+            if initial.sigma is not None:
+                raise ValueError("initial.sigma is not supported with a second state variable")
         if initial.theta is None and (initial.perturbation or 0.0) == 0.0 and V0 > 0.0:
             self.y[1] = -lv             # the exact steady state, free of the round-off of log
-        self.y[2] = self.protocol.load_point(0.0) - self.sigma_of(self.y) / m.k0
+            if self.second is not None:
+                self.y[5] = -lv
+        self.y[2] = self.protocol.load_point(0.0) - self.spring_of(self.y) / m.k0
         self.at_root = True        # v = V is a root of the extremum events
         if self.record:
             if self.t_eval is None:
@@ -540,7 +571,7 @@ class _SmoothEngine:
     def set_state(self, lv: float, q: float) -> None:
         """Restart at (ln v, q) (used by the cycle extrapolation); x follows the spring."""
         self.y = np.array([lv, q, 0.0, self.y[3], self.y[4]])
-        self.y[2] = self.protocol.load_point(self.t) - self.sigma_of(self.y) / self.model.k0
+        self.y[2] = self.protocol.load_point(self.t) - self.spring_of(self.y) / self.model.k0
         self.at_root = True
         self.emit("restart")
 
@@ -550,8 +581,10 @@ class _SmoothEngine:
         mu = np.array([self.law_fn(ui, self.p)[0] for ui in u])
         with np.errstate(over="ignore"):
             v = np.exp(y[:, 0])
-        self.samples.add(y[:, 4], y[:, 2], self.mu_ref + mu + m.a * (y[:, 0] + y[:, 1]),
-                         m.Dc * np.exp(y[:, 1]), v)
+        sigma = self.mu_ref + mu + m.a * (y[:, 0] + y[:, 1])
+        if self.second is not None:
+            sigma = sigma + self.second.b2 * (y[:, 5] + self.ln_v0)
+        self.samples.add(y[:, 4], y[:, 2], sigma, m.Dc * np.exp(y[:, 1]), v)
 
     def _output_here(self) -> None:
         """Record the pending t_eval points that coincide with the current time."""
@@ -569,6 +602,8 @@ class _SmoothEngine:
 
     def _steady_exactly(self, lnV: float) -> bool:
         tol = 4.0 * np.finfo(float).eps * (1.0 + abs(lnV))
+        if self.second is not None and abs(self.y[5] + lnV) > tol:
+            return False
         return abs(self.y[0] - lnV) <= tol and abs(self.y[1] + lnV) <= tol
 
     def _advance_steady(self, V: float, t_stop: float, t_end: float) -> Event:
@@ -620,11 +655,16 @@ class _SmoothEngine:
             return self.emit("steady")       # on a fixed point for ever
         vs = V if V > 0.0 else max(math.exp(-self.y[1]), 1e-300)
         lvs = math.log(vs)
-        c = np.array([m.K, V, m.Dc, m.a, 0.0 if m.state_law == "aging" else 1.0, vs,
+        second = self.second
+        c = np.array([m.K, V, m.Dc, m.a, self.state_code, vs,
                       lnV - lvs if V > 0.0 else 0.0, lvs - lnV if V > 0.0 else 0.0,
                       opts.cycle_rtol, steady_on, t_stop if math.isfinite(t_stop) else 1e300,
-                      math.log(self.v_max) - lvs if math.isfinite(self.v_max) else 1e300])
+                      math.log(self.v_max) - lvs if math.isfinite(self.v_max) else 1e300,
+                      self.eta, self.c_over_b, second.b2 if second is not None else 0.0,
+                      m.Dc / second.Dc2 if second is not None else 0.0, self.ln_v0 - lvs])
         k, p = self.k, self.p
+        user_rate = self.user_rate
+        Dc = m.Dc
         output = self.record and self.t_eval is not None
         if output:
             j1 = int(np.searchsorted(self.t_eval, t_stop, side="left"))
@@ -633,8 +673,17 @@ class _SmoothEngine:
         else:
             grid = np.empty(0)
 
-        def rhs(s, y, yp):
-            k.rs_rhs(y, yp, p, c)
+        if user_rate is None:
+            def rhs(s, y, yp):
+                k.rs_rhs(y, yp, p, c)
+        else:
+            def rhs(s, y, yp):
+                # d ln(theta)/ds = (dtheta/dt / theta) dt/ds, with dt/ds = Dc f / vs
+                w = y[0]
+                f = 1.0 / (1.0 + math.exp(w)) if w <= 0.0 else math.exp(-w) / (1.0 + math.exp(-w))
+                theta = Dc * math.exp(y[1]) / vs
+                rate = user_rate(vs * math.exp(min(w, 700.0)), theta)
+                k.rs_rhs_dr(y, yp, p, c, rate / theta * Dc * f / vs)
 
         def events(s, y, e):
             k.rs_events(y, e, p, c)
@@ -646,18 +695,22 @@ class _SmoothEngine:
             out = y.copy()
             out[0] = y[0] - lvs
             out[1] = y[1] + lvs
+            if second is not None:
+                out[5] = y[5] + lvs
             return out
 
         def to_global(y: np.ndarray) -> np.ndarray:
             out = np.array(y, dtype=float, copy=True)
             out[..., 0] += lvs
             out[..., 1] -= lvs
+            if second is not None:
+                out[..., 5] -= lvs
             return out
 
         t_scale = m.Dc / vs
         atol = np.array([opts.atol, opts.atol, opts.atol * m.Dc,
                          opts.atol * t_scale * max(1.0, abs(self.sigma_of(self.y) - self.mu_ref)),
-                         opts.atol * t_scale])
+                         opts.atol * t_scale] + ([opts.atol] if second is not None else []))
         y_loc = to_local(self.y)
         save_steps = self.record and not output
 
@@ -758,7 +811,7 @@ def _runaway_bound(model: SpringSlider, protocol: Protocol, options: SolverOptio
     """The velocity at which a run is declared a runaway (see ``SolverOptions.v_max``)."""
     if options.v_max is not None:
         return float(options.v_max)
-    if isinstance(model.law, LogLaw):
+    if isinstance(model.law, LogLaw) and model.eta_rad == 0.0:
         return _RUNAWAY_FACTOR * float(np.max(protocol.velocities))
     return math.inf
 
@@ -912,6 +965,8 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     V = positive("V", V)
+    if model.second_state is not None:
+        raise ValueError("limit_cycle does not support a second state variable (use simulate)")
     options = options or SolverOptions()
     initial = (initial or InitialState()).resolved(InitialState.DEFAULT_PERTURBATION)
     started = time.perf_counter()

@@ -1,0 +1,101 @@
+"""State evolution laws (aging, slip, PRZ, Nagata, a user callable) and two state
+variables, each against the independent scipy integrator of ``_independent_rs``
+(DOP853, rtol 1e-12, no code shared with rsf): 1e-8 in mu at default options on
+velocity steps, k0 = 20, 2, 1.2 k_c and a = 0.005, 0.008."""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rsf
+
+sys.path.insert(0, str(Path(__file__).parent))
+from _independent_rs import mu_at  # noqa: E402
+
+B, DC, V0, MU0 = 0.01, 10.0, 1.0, 0.6
+TE = np.linspace(0.0, 100.0, 401)
+
+
+def _user_slip(v: float, theta: float) -> float:
+    x = v * theta / DC
+    return -x * math.log(x)
+
+
+# (name, rsf state law, reference law, reference extras, second state, step velocity)
+LAWS = {
+    "prz": ("prz", "prz", {}, None, 2.0),
+    "nagata": (rsf.NagataLaw(c=2.0), "nagata", {"nagata_c": 2.0}, None, 10.0),
+    "user": (_user_slip, "slip", {}, None, 2.0),
+    "two-state aging": ("aging", "aging", {"b2": 0.004, "Dc2": 50.0}, (0.004, 50.0), 2.0),
+    "two-state slip": ("slip", "slip", {"b2": 0.004, "Dc2": 50.0}, (0.004, 50.0), 1.5),
+}
+
+
+@pytest.mark.parametrize("k_over_kc", [20.0, 2.0, 1.2])
+@pytest.mark.parametrize("a", [0.005, 0.008])
+@pytest.mark.parametrize("name", list(LAWS))
+def test_state_law_matches_independent_reference(name, a, k_over_kc):
+    state_law, ref_law, extra, second, v_step = LAWS[name]
+    k0 = k_over_kc * (B - a) / DC
+    model = rsf.standard_rs(mu0=MU0, a=a, b=B, Dc=DC, k0=k0, v0=V0, state_law=state_law,
+                            second_state=rsf.SecondState(*second) if second else None)
+    vel = [1.0, v_step, 1.0]
+    tr = rsf.simulate(model, protocol=rsf.Protocol.velocity_steps(vel, [10.0, 40.0]),
+                      t_end=100.0, t_eval=TE)
+    assert tr.success, tr.message
+    mu = mu_at(ref_law, a=a, b=B, Dc=DC, k0=k0, v0=V0, mu0=MU0, velocities=vel,
+               times=[0.0, 10.0, 50.0], t_eval=TE, **extra)
+    assert np.max(np.abs(tr.sigma - mu)) < 1e-8
+
+
+def test_nagata_with_c_zero_is_the_aging_law():
+    te = np.linspace(0.0, 60.0, 61)
+    runs = [rsf.simulate(rsf.standard_rs(a=0.005, b=B, Dc=DC, k0=0.001, v0=V0, state_law=law),
+                         protocol=rsf.Protocol.velocity_steps([1.0, 10.0], [10.0]), t_end=60.0,
+                         t_eval=te) for law in (rsf.NagataLaw(c=0.0), "aging")]
+    assert np.max(np.abs(runs[0].sigma - runs[1].sigma)) < 1e-12
+    nag = rsf.simulate(rsf.standard_rs(a=0.005, b=B, Dc=DC, k0=0.001, v0=V0,
+                                       state_law=rsf.NagataLaw(c=2.0)),
+                       protocol=rsf.Protocol.velocity_steps([1.0, 10.0], [10.0]), t_end=60.0,
+                       t_eval=te)
+    assert np.max(np.abs(nag.sigma - runs[1].sigma)) > 1e-4          # the term matters
+
+
+def test_prz_reports_half_theta_prz():
+    """rsf's theta for PRZ is theta_PRZ / 2: steady state Dc / V like the other laws."""
+    model = rsf.standard_rs(a=0.005, b=B, Dc=DC, k0=0.01, v0=V0, state_law="prz")
+    tr = rsf.simulate(model, protocol=rsf.Protocol.velocity_steps([1.0, 10.0], [10.0]),
+                      t_end=200.0, t_eval=[0.0, 200.0])
+    assert tr.theta[0] == pytest.approx(DC / 1.0, rel=1e-15)
+    assert tr.theta[-1] == pytest.approx(DC / 10.0, rel=1e-7)
+    assert tr.sigma[-1] == pytest.approx(MU0 + (0.005 - B) * math.log(10.0), abs=1e-9)
+
+
+def test_docstrings_give_equation_and_reference():
+    for cls in (rsf.AgingLaw, rsf.SlipLaw, rsf.PRZLaw, rsf.NagataLaw):
+        doc = cls.__doc__
+        assert ".. math::" in doc and any(str(y) in doc for y in (1979, 1983, 1995, 2012))
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: rsf.SpringSlider(k0=0.01, state_law="prz"), "needs a direct effect a > 0"),
+    (lambda: rsf.SpringSlider(k0=0.01, state_law="bogus"), "state_law must be one of"),
+    (lambda: rsf.SpringSlider(k0=0.01, a=0.01, state_law=rsf.NagataLaw(2.0)), "NagataLaw"),
+    (lambda: rsf.NagataLaw(c=-1.0), "c must be a finite number >= 0"),
+    (lambda: rsf.CallableStateLaw(func=lambda v, th: math.nan), "finite"),
+    (lambda: rsf.CallableStateLaw(func=3), "callable"),
+    (lambda: rsf.SecondState(b2=0.0, Dc2=1.0), "b2 must be a finite number > 0"),
+    (lambda: rsf.SpringSlider(k0=0.01, a=0.01, second_state=rsf.SecondState(0.01, 1.0)),
+     "second_state needs the log law"),
+    (lambda: rsf.standard_rs(state_law=rsf.NagataLaw(1.0), second_state=rsf.SecondState(0.01, 1.0)),
+     "second_state works with"),
+    (lambda: rsf.limit_cycle(rsf.standard_rs(second_state=rsf.SecondState(0.01, 1.0)), 1e-6),
+     "second state"),
+])
+def test_bad_state_law_input(make, match):
+    with pytest.raises(ValueError, match=match):
+        make()
