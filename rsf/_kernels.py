@@ -611,11 +611,13 @@ def rs_rhs_dr(y, yp, p, c, dr_user):
     :math:`q_2 = \ln(v_s\theta_2/D_{c2})` (all 0 in steady sliding at :math:`V = v_s`,
     so that event functions near it are not differences of large numbers) and
     :math:`I = \int (\mu - \mu_{ref})\,\mathrm{d}t`;
-    ``c = [K, V, Dc, a, state_law, v_s, ...events..., eta, c/b, b2, Dc/Dc2, ln(v0/v_s)]``
-    (indices 12 to 16).
+    ``c = [K, V, Dc, a, state_law, v_s, ...events..., eta, c/b, b2, Dc/Dc2, ln(v0/v_s),
+    dV/dt, t_0]`` (indices 12 to 18; with a ramp :math:`V(t) = V + \dot V (t - t_0)`).
     """
     K = c[0]
     V = c[1]
+    if c[17] != 0.0:                 # a sampled history: V ramps linearly in t
+        V = max(V + c[17] * (y[4] - c[18]), 0.0)
     Dc = c[2]
     a = c[3]
     code = c[4]
@@ -676,9 +678,15 @@ def rs_rhs_dr(y, yp, p, c, dr_user):
 def rs_events(y, e, p, c):
     """Events of the a > 0 ODE: ``e[0]`` and ``e[1]`` ln(v/V) (sigma maximum when rising,
     minimum when falling), ``e[2]`` distance to the steady state minus s_tol, ``e[3]``
-    t - t_stop, ``e[4]`` ln(v/v_max) (runaway).
+    t - t_stop, ``e[4]`` ln(v/v_max) (runaway); with a ramp ``c[17] != 0`` the extrema are
+    at v = V(t) and there is no steady state.
     ``c[6:12] = [ln(V/v_s), ln(v_s/V), s_tol, steady_on, t_stop, ln(v_max/v_s)]``."""
-    if c[1] > 0.0:
+    if c[17] != 0.0:                 # a ramp: extrema of the spring force at v = V(t)
+        V = c[1] + c[17] * (y[4] - c[18])
+        e[0] = y[0] - math.log(V / c[5]) if V > 0.0 else 1.0
+        e[1] = e[0]
+        e[2] = 1.0
+    elif c[1] > 0.0:
         e[0] = y[0] - c[6]
         e[1] = e[0]
         if c[9] > 0.0:

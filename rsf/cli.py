@@ -27,6 +27,7 @@ from .analysis import critical_velocity
 from .laws import PAPER_A, PAPER_B, PAPER_DC, HyperbolicLaw, LogLaw, TabulatedLaw, ViscoelasticLaw
 from ._validation import positive
 from .params import Protocol, SolverOptions, SpringSlider
+from .state_laws import NagataLaw, SecondState
 from .solver import simulate, sweep
 
 __all__ = ["main", "build_parser"]
@@ -105,8 +106,19 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
                    help="steady-state law: hyperbolic = Eq. (10) A/(v+B) + mu_inf (default); "
                         "viscoelastic = Eq. (4); log = Eq. (9), mu0 + (a-b) ln(v/v0); "
                         "table = PCHIP interpolation of a CSV (--table)")
-    g.add_argument("--state-law", choices=("aging", "slip"), default="aging",
-                   help="state evolution: aging (Eq. 8, default) or Ruina slip law (needs --a > 0)")
+    g.add_argument("--state-law", choices=("aging", "slip", "prz", "nagata"), default="aging",
+                   help="state evolution: aging (Eq. 8, default), Ruina slip, Perrin-Rice-Zheng "
+                        "(prz) or Nagata; all but aging need --a > 0")
+    g.add_argument("--nagata-c", type=float, default=2.0,
+                   help="Nagata's stress-rate coefficient c >= 0 (with --state-law nagata; "
+                        "b from the log law, default 2)")
+    g.add_argument("--b2", type=float, default=None,
+                   help="second state variable: its evolution effect b2 > 0 (log law, a > 0)")
+    g.add_argument("--Dc2", type=float, default=None,
+                   help="second state variable: its critical slip distance Dc2 > 0")
+    g.add_argument("--eta-rad", type=float, default=0.0,
+                   help="radiation damping eta_rad >= 0: k0 (X - x) = mu + eta_rad v (needs a > 0; "
+                        "default 0, the paper's model)")
     g.add_argument("--a", type=float, default=None,
                    help="direct effect a >= 0 (default: the law's a for --law log, else 0, "
                         "the paper's model with stick, slide and instantaneous slip)")
@@ -171,7 +183,16 @@ def _law(args: argparse.Namespace, k0: float):
 
 
 def _model(args: argparse.Namespace, k0: float) -> SpringSlider:
-    return SpringSlider(law=_law(args, k0), k0=k0, Dc=args.Dc, a=args.a, state_law=args.state_law)
+    state_law: object = args.state_law
+    if state_law == "nagata":
+        state_law = NagataLaw(c=args.nagata_c)
+    second = None
+    if (args.b2 is None) != (args.Dc2 is None):
+        raise ValueError("give both --b2 and --Dc2 for a second state variable")
+    if args.b2 is not None:
+        second = SecondState(args.b2, args.Dc2)
+    return SpringSlider(law=_law(args, k0), k0=k0, Dc=args.Dc, a=args.a, state_law=state_law,
+                        second_state=second, eta_rad=args.eta_rad)
 
 
 def _options(args: argparse.Namespace) -> SolverOptions:
@@ -235,6 +256,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="velocity steps V1:T1,V2:T2,...,Vn (velocity:duration, last open-ended)")
     pr.add_argument("--shs", type=float, nargs=3, metavar=("V", "SLIDE", "HOLD"), default=None,
                     help="slide-hold-slide: slide at V for SLIDE, hold for HOLD, slide again")
+    pr.add_argument("--history", default=None,
+                    help="sampled load-point velocity V(t): a CSV file with columns t and V "
+                         "(t from 0, strictly increasing), linear between the samples (a > 0)")
     pr.add_argument("--t-end", type=float, required=True, help="end time > 0")
     pr.add_argument("--out", required=True, help="output CSV for the time series")
     pr.add_argument("--events", default=None, help="output CSV for the events t, kind, sigma, theta, x")
@@ -249,11 +273,21 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _protocol(args: argparse.Namespace) -> tuple[float | None, Protocol | None]:
-    given = [x is not None for x in (args.V, args.steps, args.shs)]
+    given = [x is not None for x in (args.V, args.steps, args.shs, args.history)]
     if sum(given) != 1:
-        raise ValueError("give exactly one of --V, --steps, --shs")
+        raise ValueError("give exactly one of --V, --steps, --shs, --history")
     if args.V is not None:
         return args.V, None
+    if args.history is not None:
+        import pandas as pd
+
+        try:
+            frame = pd.read_csv(args.history)
+        except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+            raise ValueError(f"--history {args.history!r} cannot be read: {exc}") from None
+        if not {"t", "V"} <= set(frame.columns):
+            raise ValueError(f"--history needs columns t and V, got {list(frame.columns)}")
+        return None, Protocol.sampled(frame["t"].to_numpy(float), frame["V"].to_numpy(float))
     if args.shs is not None:
         V, slide, hold = args.shs
         return None, Protocol.slide_hold_slide(V, slide, hold)

@@ -146,14 +146,20 @@ def standard_rs(mu0: float = 0.6, a: float = 0.01, b: float = 0.015, Dc: float =
 
 @dataclass(frozen=True, eq=False)
 class Protocol:
-    r"""Piecewise-constant load-point velocity: ``velocities[i]`` from ``times[i]`` to
-    ``times[i + 1]`` (the last one forever).  ``times[0]`` must be 0.
+    r"""Load-point velocity history :math:`V(t)`.
 
-    Build it with :meth:`constant`, :meth:`velocity_steps` or :meth:`slide_hold_slide`.
+    With ``interpolation='previous'`` (default) it is piecewise constant:
+    ``velocities[i]`` from ``times[i]`` to ``times[i + 1]`` (the last one forever); with
+    ``'linear'`` it is the piecewise-linear interpolation of the samples (constant after
+    the last one), a sampled history.  ``times[0]`` must be 0.
+
+    Build it with :meth:`constant`, :meth:`velocity_steps`, :meth:`slide_hold_slide` or
+    :meth:`sampled`.
     """
 
     times: np.ndarray
     velocities: np.ndarray
+    interpolation: str = "previous"
 
     def __post_init__(self) -> None:
         times = np.atleast_1d(np.asarray(self.times, dtype=float)).copy()
@@ -167,10 +173,43 @@ class Protocol:
             raise ValueError("times must be finite and strictly increasing")
         if not np.all(np.isfinite(vel)) or np.any(vel < 0.0):
             raise ValueError("velocities must be finite and >= 0")
+        choice("interpolation", self.interpolation, ("previous", "linear"))
         times.setflags(write=False)
         vel.setflags(write=False)
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "velocities", vel)
+        # load-point displacement at each sample time
+        dt = np.diff(times)
+        if self.interpolation == "linear":
+            steps = 0.5 * dt * (vel[:-1] + vel[1:])
+        else:
+            steps = dt * vel[:-1]
+        xs = np.concatenate([[0.0], np.cumsum(steps)])
+        xs.setflags(write=False)
+        object.__setattr__(self, "_x_at_times", xs)
+
+    @classmethod
+    def sampled(cls, times: Sequence[float], velocities: Sequence[float]) -> Protocol:
+        r"""A sampled history :math:`V(t)`: linear between the samples (``times[0] = 0``,
+        strictly increasing; velocities >= 0), constant after the last one.  The load
+        point :math:`X(t) = \int_0^t V` is then exact (piecewise quadratic)."""
+        return cls(np.asarray(times, dtype=float), np.asarray(velocities, dtype=float),
+                   interpolation="linear")
+
+    @property
+    def is_linear(self) -> bool:
+        """Whether V(t) ramps linearly between samples (a sampled history)."""
+        return self.interpolation == "linear" and self.times.size > 1
+
+    def slope_at(self, t: float) -> float:
+        """dV/dt on the sample interval that starts at or before ``t`` (0 for steps)."""
+        if not self.is_linear:
+            return 0.0
+        i = int(np.searchsorted(self.times, t, side="right")) - 1
+        if i < 0 or i >= self.times.size - 1:
+            return 0.0
+        return float((self.velocities[i + 1] - self.velocities[i])
+                     / (self.times[i + 1] - self.times[i]))
 
     @classmethod
     def constant(cls, V: float) -> Protocol:
@@ -201,6 +240,8 @@ class Protocol:
         """The load-point velocity at time ``t`` (right-continuous)."""
         if self.times.size == 1:
             return float(self.velocities[0])
+        if self.is_linear:
+            return float(np.interp(t, self.times, self.velocities))
         i = int(np.searchsorted(self.times, t, side="right")) - 1
         return float(self.velocities[max(i, 0)])
 
@@ -217,8 +258,11 @@ class Protocol:
             return float(self.velocities[0]) * t
         i = int(np.searchsorted(self.times, t, side="right")) - 1
         i = max(i, 0)
-        dt = np.diff(self.times[: i + 1])
-        return float(np.dot(dt, self.velocities[:i]) + self.velocities[i] * (t - self.times[i]))
+        tau = t - self.times[i]
+        x = float(self._x_at_times[i]) + float(self.velocities[i]) * tau   # type: ignore[attr-defined]
+        if self.is_linear:
+            x += 0.5 * self.slope_at(t) * tau * tau
+        return x
 
     @property
     def is_constant(self) -> bool:

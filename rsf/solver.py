@@ -647,9 +647,12 @@ class _SmoothEngine:
         q_ss = -lnV
         w_ss = float(self.law_fn(V, self.p)[1]) if V > 0.0 else 0.0
         steady_on = 1.0 if (self.stop_at_steady and V > 0.0 and m.K - w_ss > 0.0) else 0.0
+        slope = self.protocol.slope_at(t_now)
+        if slope != 0.0:
+            steady_on = 0.0
         if steady_on and abs(self.y[0] - lnV) + abs(self.y[1] - q_ss) <= opts.cycle_rtol:
             return self.emit("steady")
-        if V > 0.0 and self._steady_exactly(lnV):
+        if V > 0.0 and slope == 0.0 and self._steady_exactly(lnV):
             if math.isfinite(t_stop):
                 return self._advance_steady(V, t_stop, t_end)
             return self.emit("steady")       # on a fixed point for ever
@@ -661,7 +664,8 @@ class _SmoothEngine:
                       opts.cycle_rtol, steady_on, t_stop if math.isfinite(t_stop) else 1e300,
                       math.log(self.v_max) - lvs if math.isfinite(self.v_max) else 1e300,
                       self.eta, self.c_over_b, second.b2 if second is not None else 0.0,
-                      m.Dc / second.Dc2 if second is not None else 0.0, self.ln_v0 - lvs])
+                      m.Dc / second.Dc2 if second is not None else 0.0, self.ln_v0 - lvs,
+                      slope, t_now])
         k, p = self.k, self.p
         user_rate = self.user_rate
         Dc = m.Dc
@@ -874,6 +878,9 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     initial = initial.resolved(InitialState.DEFAULT_PERTURBATION if protocol.is_constant else 0.0)
     options = options or SolverOptions()
     t_eval = _check_t_eval(t_eval, t_end)
+    if model.a == 0.0 and protocol.is_linear:
+        raise ValueError("a sampled (linearly interpolated) load history needs a direct "
+                         "effect a > 0; for a = 0 use piecewise-constant steps")
     if model.a == 0.0:
         engine = _PhaseEngine(model, protocol, options, record=True,
                               stop_at_steady=stop_at_steady, t_eval=t_eval)

@@ -187,3 +187,29 @@ def test_run_t_eval_and_runaway_on_the_command_line(tmp_path, capsys):
                  "--t-eval", "0,70", "--out", str(out)]) == 2
     assert main(["run", "--k0", "0.01", *log, "--V", "1", "--t-end", "60",
                  "--t-eval-n", "1", "--out", str(out)]) == 2
+
+
+def test_run_history_state_laws_and_damping_on_the_command_line(tmp_path):
+    hist = tmp_path / "history.csv"
+    ts = np.linspace(0.0, 30.0, 31)
+    pd.DataFrame({"t": ts, "V": 1.0 + 0.5 * np.sin(ts) ** 2}).to_csv(hist, index=False)
+    out = tmp_path / "run.csv"
+    log = ["--law", "log", "--b", "0.01", "--law-a", "0.005", "--a", "0.005", "--v0", "1",
+           "--Dc", "10", "--mu0", "0.6"]
+    extra = ["--state-law", "nagata", "--nagata-c", "1.5", "--b2", "0.003", "--Dc2", "30"]
+    # Nagata with a second state is refused by the model (exit status 2)
+    assert main(["run", "--k0", "0.01", *log, *extra, "--history", str(hist),
+                 "--t-end", "40", "--out", str(out)]) == 2
+    assert main(["run", "--k0", "0.01", *log, "--state-law", "prz", "--b2", "0.003", "--Dc2", "30",
+                 "--eta-rad", "0.001", "--history", str(hist), "--t-end", "40", "--t-eval-n", "41",
+                 "--out", str(out)]) == 0
+    series = pd.read_csv(out)
+    model = rsf.standard_rs(mu0=0.6, a=0.005, b=0.01, Dc=10.0, k0=0.01, v0=1.0, state_law="prz",
+                            second_state=rsf.SecondState(0.003, 30.0), eta_rad=0.001)
+    api = rsf.simulate(model, protocol=rsf.Protocol.sampled(ts, 1.0 + 0.5 * np.sin(ts) ** 2),
+                       t_end=40.0, t_eval=np.linspace(0.0, 40.0, 41))
+    assert np.abs(series.sigma.to_numpy() - api.sigma).max() < 1e-14
+    assert main(["run", "--k0", "0.01", *log, "--b2", "0.003", "--V", "1", "--t-end", "4",
+                 "--out", str(out)]) == 2                                  # --Dc2 missing
+    assert main(["run", "--k0", "0.01", *log, "--history", str(tmp_path / "nope.csv"),
+                 "--t-end", "4", "--out", str(out)]) == 2

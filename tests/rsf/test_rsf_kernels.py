@@ -44,7 +44,7 @@ def test_compiled_kernels_match_plain_python(k0, V):
                               (0, 0.1, 0, 0), (3, 0.1, 0.5, 0), (1, 0, 0, 0.01), (2, 0.1, 0, 0.01)]:
         y = np.array([0.4, -0.2, 0.0, 0.0, 0.0, 0.3])
         c = np.array([m.K, V, m.Dc, 1e-3, code, V, 0.0, 0.0, 1e-8, 0.0, 1e9, 1e300,
-                      eta, cb, b2, 0.7, 0.1])
+                      eta, cb, b2, 0.7, 0.1, 0.02 * (code == 1), 0.5])
         ya, yb = np.zeros(6), np.zeros(6)
         K.rs_rhs(y, ya, p, c)
         PLAIN["rs_rhs"](y, yb, p, c)
