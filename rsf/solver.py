@@ -34,6 +34,7 @@ from . import _kernels
 from ._sundials import OdeSolution, integrate, integrate_outputs
 from ._validation import positive
 from .laws import LogLaw
+from .analysis import stability_margin
 from .state_laws import NAGATA, USER
 from .params import InitialState, Protocol, SolverOptions, SpringSlider
 from .results import STATUS_MESSAGES, CycleResult, Event, Status, SweepResult, Trajectory
@@ -645,8 +646,8 @@ class _SmoothEngine:
         t_stop = min(self.protocol.segment_end(t_now), t_end)
         lnV = math.log(V) if V > 0.0 else 0.0
         q_ss = -lnV
-        w_ss = float(self.law_fn(V, self.p)[1]) if V > 0.0 else 0.0
-        steady_on = 1.0 if (self.stop_at_steady and V > 0.0 and m.K - w_ss > 0.0) else 0.0
+        steady_on = 1.0 if (self.stop_at_steady and V > 0.0
+                            and stability_margin(m, V) < 0.0) else 0.0
         slope = self.protocol.slope_at(t_now)
         if slope != 0.0:
             steady_on = 0.0

@@ -39,21 +39,14 @@ def state_rate(law: str, v: float, theta: float, Dc: float) -> float:
     return _dln_theta(law, v, theta, Dc)
 
 
-def reference(law: str, *, a: float, b: float, Dc: float, k0: float, v0: float, mu0: float,
-              velocity: Callable[[float], float], breaks, t_eval: np.ndarray, eta: float = 0.0,
-              nagata_c: float = 0.0, b2: float = 0.0, Dc2: float = 1.0,
-              user=None) -> dict[str, np.ndarray]:
-    """mu and v at ``t_eval`` for the load-point velocity ``velocity(t)`` (smooth inside
-    each interval between the ``breaks``, where the integration restarts with the value
-    just after the break), from steady state at ``velocity(0)``.
-
-    ``law``: aging, slip, prz, nagata (aging with the stress-rate term, Nagata et al.
-    2012) or user (``user(v, theta) -> dtheta/dt``)."""
+def make_rhs(law: str, *, a: float, b: float, Dc: float, k0: float, velocity, eta: float = 0.0,
+             nagata_c: float = 0.0, b2: float = 0.0, Dc2: float = 1.0, user=None):
+    """d/dt of (ln v, ln theta[, ln theta2]) at load-point velocity ``velocity(t)``."""
     two = b2 > 0.0
     base = "aging" if law == "nagata" else law
 
-    def rhs(t, y, t_left, t_right):
-        V = velocity(min(max(t, t_left), t_right))     # the interval's own V at its ends
+    def rhs(t, y):
+        V = velocity(t)
         v = np.exp(y[0])
         spring_rate = k0 * (V - v)
         d1 = _dln_theta(base, v, np.exp(y[1]), Dc, user)
@@ -66,6 +59,30 @@ def reference(law: str, *, a: float, b: float, Dc: float, k0: float, v0: float, 
         else:
             L = (spring_rate - b * d1 - b2 * d2) / (a + eta * v)
         return [L, d1, d2] if two else [L, d1]
+
+    return rhs
+
+
+def reference(law: str, *, a: float, b: float, Dc: float, k0: float, v0: float, mu0: float,
+              velocity: Callable[[float], float], breaks, t_eval: np.ndarray, eta: float = 0.0,
+              nagata_c: float = 0.0, b2: float = 0.0, Dc2: float = 1.0,
+              user=None) -> dict[str, np.ndarray]:
+    """mu and v at ``t_eval`` for the load-point velocity ``velocity(t)`` (smooth inside
+    each interval between the ``breaks``, where the integration restarts with the value
+    just after the break), from steady state at ``velocity(0)``.
+
+    ``law``: aging, slip, prz, nagata (aging with the stress-rate term, Nagata et al.
+    2012) or user (``user(v, theta) -> dtheta/dt``)."""
+    two = b2 > 0.0
+    base = "aging" if law == "nagata" else law
+    clamp = [0.0, 0.0]          # the interval's own V at its ends
+
+    inner = make_rhs(law, a=a, b=b, Dc=Dc, k0=k0, eta=eta, nagata_c=nagata_c, b2=b2, Dc2=Dc2,
+                     user=user, velocity=lambda t: velocity(min(max(t, clamp[0]), clamp[1])))
+
+    def rhs(t, y, t_left, t_right):
+        clamp[0], clamp[1] = t_left, t_right
+        return inner(t, y)
 
     V0 = velocity(0.0)
     y = [np.log(V0), np.log(_theta_ss(base, V0, Dc))]
