@@ -944,8 +944,12 @@ class _Cycle:
 
 
 def _relative_change(a: _Cycle, b: _Cycle) -> float:
+    """Largest relative change of sigma_max, sigma_min, the period and the amplitude
+    sigma_max - sigma_min (the amplitude: so that a slowly decaying oscillation of small
+    amplitude is not taken for a converged cycle)."""
     out = 0.0
-    for x, y in ((a.sigma_max, b.sigma_max), (a.sigma_min, b.sigma_min), (a.period, b.period)):
+    for x, y in ((a.sigma_max, b.sigma_max), (a.sigma_min, b.sigma_min), (a.period, b.period),
+                 (a.sigma_max - a.sigma_min, b.sigma_max - b.sigma_min)):
         scale = max(abs(x), abs(y), 1e-300)
         out = max(out, abs(x - y) / scale)
     return out
