@@ -106,16 +106,21 @@ def steady_jacobian(model: SpringSlider, V: float) -> np.ndarray:
     :math:`\psi_\tau = -(\xi + \psi)`), with :math:`K = k_0 D_c`,
     :math:`W = W(V)` and :math:`\eta = \eta_{rad}`: trace
     :math:`(W - K - \eta V)/(a + \eta V)`, determinant :math:`K/(a + \eta V) > 0`.  The
-    Nagata law adds :math:`(c/b)(K\xi + \eta V\xi_\tau)` to :math:`\psi_\tau`.
+    Nagata law adds :math:`(c/b)(K\xi + \eta V\xi_\tau)` to :math:`\psi_\tau`.  For a
+    user law :math:`\psi_\tau = p\,\xi + q\,\psi` with :math:`p, q` the logarithmic
+    derivatives of :math:`(D_c/V)\,\dot\theta/\theta` (central differences of the
+    user's function), and the first row becomes
+    :math:`(-K - (W + a)p,\; -(W + a)q)/(a + \eta V)`.
     """
     from .state_laws import NAGATA, USER
 
     V = positive("V", V)
     if model.a == 0.0:
         raise ValueError("steady_jacobian needs a direct effect a > 0")
-    if model.state.code == USER or model.second_state is not None:
-        raise ValueError("steady_jacobian covers the aging, slip, PRZ and Nagata laws with "
-                         "one state variable")
+    if model.second_state is not None:
+        raise ValueError("steady_jacobian covers one state variable")
+    if model.state.code == USER:
+        return _user_jacobian(model, V)
     K = model.K
     a = model.a
     W = float(model.law.weakening(np.array([V]))[0])
@@ -133,16 +138,37 @@ def steady_jacobian(model: SpringSlider, V: float) -> np.ndarray:
     return np.array([[j11, j12], [j21, j22]])
 
 
+def _user_jacobian(model: SpringSlider, V: float) -> np.ndarray:
+    Dc = model.Dc
+    theta = Dc / V
+    func = model.state.func
+
+    def g(lv: float, lth: float) -> float:       # (Dc / V) d ln(theta)/dt
+        th = math.exp(lth)
+        return Dc / V * float(func(math.exp(lv), th)) / th
+
+    h = 1e-6
+    lv, lth = math.log(V), math.log(theta)
+    p = (g(lv + h, lth) - g(lv - h, lth)) / (2 * h)
+    q = (g(lv, lth + h) - g(lv, lth - h)) / (2 * h)
+    W = float(model.law.weakening(np.array([V]))[0])
+    D = model.a + model.eta_rad * V
+    Wa = W + model.a
+    return np.array([[(-model.K - Wa * p) / D, -Wa * q / D], [p, q]])
+
+
 def stability_margin(model: SpringSlider, V: float) -> float:
     r"""Positive where steady sliding at ``V`` is linearly unstable, negative where it is
     stable, zero at the Hopf bifurcation: :math:`W(V) - k_0 D_c - \eta_{rad}V` (the
     trace of :func:`steady_jacobian` times :math:`a + \eta V`) for the aging, slip and
-    PRZ laws and for :math:`a = 0`; the trace of the Jacobian for the Nagata law (whose
-    determinant stays positive, so that the trace decides)."""
-    from .state_laws import NAGATA
+    PRZ laws and for :math:`a = 0`; the trace of the Jacobian for the Nagata and user laws
+    when its determinant is positive (a saddle, determinant < 0, counts as unstable)."""
+    from .state_laws import NAGATA, USER
 
-    if model.state.code == NAGATA and model.a > 0.0:
-        return float(np.trace(steady_jacobian(model, V)))
+    if model.state.code in (NAGATA, USER) and model.a > 0.0:
+        J = steady_jacobian(model, V)
+        det = float(np.linalg.det(J))
+        return float(np.trace(J)) if det > 0.0 else abs(det) + 1e-300   # a saddle: unstable
     W = float(model.law.weakening(np.array([V]))[0])
     return W - model.K - model.eta_rad * V
 
@@ -170,7 +196,7 @@ def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: f
     """
     if isinstance(law, SpringSlider):
         model = law
-        if model.eta_rad > 0.0 or (model.state.name == "nagata" and model.a > 0.0):
+        if model.eta_rad > 0.0 or (model.state.code in (3, 4) and model.a > 0.0):
             return _critical_velocity_scan(model, v_min, v_max)
         law, k0, Dc = model.law, model.k0, model.Dc
     if law is None:

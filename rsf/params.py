@@ -21,7 +21,15 @@ import numpy as np
 
 from ._validation import choice, nonnegative, positive, positive_int
 from .laws import PAPER_DC, HyperbolicLaw, LogLaw, SteadyStateLaw
-from .state_laws import AgingLaw, NagataLaw, PRZLaw, SecondState, SlipLaw, state_law_from
+from .state_laws import (
+    AgingLaw,
+    CallableStateLaw,
+    NagataLaw,
+    PRZLaw,
+    SecondState,
+    SlipLaw,
+    state_law_from,
+)
 
 __all__ = ["SpringSlider", "Protocol", "InitialState", "SolverOptions", "standard_rs"]
 
@@ -88,6 +96,12 @@ class SpringSlider:
             pass
         elif isinstance(state, (AgingLaw, SlipLaw, PRZLaw)) and state == type(state)():
             object.__setattr__(self, "state_law", state.name)
+        if isinstance(state, CallableStateLaw):
+            rate_ss = state.rate(1.0, self.Dc, self.Dc)
+            scale = max(abs(state.rate(1.0, 2.0 * self.Dc, self.Dc)), 1e-300)
+            if not abs(rate_ss) <= 1e-9 * scale:
+                raise ValueError(f"a user state law must have its steady state at theta = Dc/v "
+                                 f"(the friction law assumes it): f(1, Dc) = {rate_ss!r}, not 0")
         if state.code != AgingLaw.code and self.a == 0.0:
             raise ValueError(f"state_law={state.name!r} needs a direct effect a > 0 (with a = 0 "
                              f"the instantaneous slip is defined for the aging law only); got a = 0")

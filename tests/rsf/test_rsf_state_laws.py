@@ -99,3 +99,27 @@ def test_docstrings_give_equation_and_reference():
 def test_bad_state_law_input(make, match):
     with pytest.raises(ValueError, match=match):
         make()
+
+
+def test_user_law_stability_and_limit_cycle_match_the_built_in_law():
+    """A user callable equal to the aging law: same Jacobian (finite differences of the
+    user's function), same Vc with radiation damping, same limit cycle."""
+    from rsf.analysis import steady_jacobian
+
+    def aging(v: float, theta: float) -> float:
+        return 1.0 - v * theta / DC
+
+    kw = dict(mu0=MU0, a=0.005, b=B, Dc=DC, k0=0.0004, v0=V0, eta_rad=1e-4)
+    user, built_in = rsf.standard_rs(state_law=aging, **kw), rsf.standard_rs(**kw)
+    np.testing.assert_allclose(steady_jacobian(user, 3.0), steady_jacobian(built_in, 3.0),
+                               rtol=1e-8)
+    assert rsf.critical_velocity(user).Vc == pytest.approx(10.0, rel=1e-8)
+    r_user, r_built = rsf.limit_cycle(user, 5.0), rsf.limit_cycle(built_in, 5.0)
+    assert r_user.converged and r_user.regime == "stick-slip"
+    assert r_user.sigma_max == pytest.approx(r_built.sigma_max, abs=1e-7)
+    assert r_user.period == pytest.approx(r_built.period, rel=1e-6)
+
+
+def test_user_law_must_have_the_standard_steady_state():
+    with pytest.raises(ValueError, match="steady state at theta = Dc/v"):
+        rsf.standard_rs(Dc=DC, state_law=lambda v, th: 1.0 - v * th / (2 * DC))
