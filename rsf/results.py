@@ -74,7 +74,9 @@ class Trajectory:
     Attributes
     ----------
     t, x, sigma, theta, v : ndarray
-        Samples (a slip appears as two samples at the same time).
+        Samples (a slip appears as two samples at the same time), at the integrator's steps
+        or at ``t_eval``.  ``sigma`` is the friction; with radiation damping the spring
+        force is ``sigma + eta_rad * v``.
     events : list of Event
         Every event of the run.
     status : int

@@ -772,7 +772,9 @@ class _SmoothEngine:
             self._count(sol)
             for (_s, y_ev, idx, _sign) in sol.events:
                 if idx == 0 or (idx == 1 and not stop_on_min):
-                    if abs(y_ev[1] - c[7]) > self.extremum_floor:    # not round-off
+                    # a time series drops extrema at round-off distance from steady state;
+                    # a limit-cycle search keeps them all (tiny cycles near a Hopf point)
+                    if stop_on_min or abs(y_ev[1] - c[7]) > self.extremum_floor:
                         self.emit("sigma_max" if idx == 0 else "sigma_min", to_global(y_ev))
             take_outputs(sol, len(terminal))
             y_loc = sol.y[-1].copy()       # the system is autonomous in s: restart at 0
