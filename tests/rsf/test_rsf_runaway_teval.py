@@ -191,3 +191,15 @@ def test_velocity_steps_start_at_exact_steady_state():
     assert np.all(shs.v == 1.0)
     const = rsf.simulate(model, V=1.0, t_end=5.0)            # constant driving: perturbed
     assert const.v[-1] != 1.0
+
+
+def test_t_eval_keeps_the_samples_before_a_runaway():
+    model = _model("aging", 0.005, 0.8)
+    te = np.linspace(0.0, 60.0, 61)
+    tr = rsf.simulate(model, protocol=STEP, t_end=60.0, t_eval=te)
+    assert tr.status == rsf.Status.RUNAWAY
+    assert np.array_equal(tr.t, te[:14])                    # 0, 1, ..., 13 < 13.1178
+    mu = mu_at("aging", a=0.005, b=B, Dc=DC, k0=model.k0, v0=V0, mu0=MU0,
+               velocities=[1.0, 10.0], times=[0.0, 10.0], t_eval=te[:14])
+    assert np.max(np.abs(tr.sigma - mu)) < 1e-8
+    assert tr.events[-1].kind == "runaway" and tr.events[-1].t == pytest.approx(13.11778153, abs=1e-7)
