@@ -102,6 +102,7 @@ def steady_jacobian(model: SpringSlider, V: float) -> np.ndarray:
           -(a + \eta V) & -(a + \eta V)\end{pmatrix}
           \begin{pmatrix}\xi\\ \psi\end{pmatrix}
 
+    (with a second state variable a 3 x 3 matrix, :func:`_two_state_jacobian`)
     for the aging, slip and PRZ laws (they share the linearisation
     :math:`\psi_\tau = -(\xi + \psi)`), with :math:`K = k_0 D_c`,
     :math:`W = W(V)` and :math:`\eta = \eta_{rad}`: trace
@@ -118,7 +119,7 @@ def steady_jacobian(model: SpringSlider, V: float) -> np.ndarray:
     if model.a == 0.0:
         raise ValueError("steady_jacobian needs a direct effect a > 0")
     if model.second_state is not None:
-        raise ValueError("steady_jacobian covers one state variable")
+        return _two_state_jacobian(model, V)
     if model.state.code == USER:
         return _user_jacobian(model, V)
     K = model.K
@@ -136,6 +137,20 @@ def steady_jacobian(model: SpringSlider, V: float) -> np.ndarray:
     j21 = -1.0 + kappa * K + kappa * damp * j11
     j22 = -1.0 + kappa * damp * j12
     return np.array([[j11, j12], [j21, j22]])
+
+
+def _two_state_jacobian(model: SpringSlider, V: float) -> np.ndarray:
+    r"""3 x 3 Jacobian in :math:`(\xi, \psi_1, \psi_2)` for a second state variable:
+    :math:`\psi_{2,\tau} = -\rho(\xi + \psi_2)` with :math:`\rho = D_c/D_{c2}`, and
+    :math:`(a + \eta V)\xi_\tau = -K\xi + (W + a)(\xi + \psi_1) + b_2\rho(\xi + \psi_2)`."""
+    rho = model.Dc / model.second_state.Dc2
+    b2 = model.second_state.b2
+    W = float(model.law.weakening(np.array([V]))[0])
+    Wa = W + model.a
+    D = model.a + model.eta_rad * V
+    return np.array([[(-model.K + Wa + b2 * rho) / D, Wa / D, b2 * rho / D],
+                     [-1.0, -1.0, 0.0],
+                     [-rho, 0.0, -rho]])
 
 
 def _user_jacobian(model: SpringSlider, V: float) -> np.ndarray:
@@ -162,9 +177,12 @@ def stability_margin(model: SpringSlider, V: float) -> float:
     stable, zero at the Hopf bifurcation: :math:`W(V) - k_0 D_c - \eta_{rad}V` (the
     trace of :func:`steady_jacobian` times :math:`a + \eta V`) for the aging, slip and
     PRZ laws and for :math:`a = 0`; the trace of the Jacobian for the Nagata and user laws
-    when its determinant is positive (a saddle, determinant < 0, counts as unstable)."""
+    when its determinant is positive (a saddle, determinant < 0, counts as unstable); the
+    largest real part of the eigenvalues with a second state variable."""
     from .state_laws import NAGATA, USER
 
+    if model.second_state is not None:
+        return float(np.max(np.linalg.eigvals(steady_jacobian(model, V)).real))
     if model.state.code in (NAGATA, USER) and model.a > 0.0:
         J = steady_jacobian(model, V)
         det = float(np.linalg.det(J))
@@ -196,7 +214,8 @@ def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: f
     """
     if isinstance(law, SpringSlider):
         model = law
-        if model.eta_rad > 0.0 or (model.state.code in (3, 4) and model.a > 0.0):
+        if (model.eta_rad > 0.0 or model.second_state is not None
+                or (model.state.code in (3, 4) and model.a > 0.0)):
             return _critical_velocity_scan(model, v_min, v_max)
         law, k0, Dc = model.law, model.k0, model.Dc
     if law is None:

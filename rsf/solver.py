@@ -25,7 +25,7 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Iterable
 
 import numpy as np
@@ -651,7 +651,10 @@ class _SmoothEngine:
         slope = self.protocol.slope_at(t_now)
         if slope != 0.0:
             steady_on = 0.0
-        if steady_on and abs(self.y[0] - lnV) + abs(self.y[1] - q_ss) <= opts.cycle_rtol:
+        distance = abs(self.y[0] - lnV) + abs(self.y[1] - q_ss)
+        if self.second is not None:
+            distance += abs(self.y[5] - q_ss)
+        if steady_on and distance <= opts.cycle_rtol:
             return self.emit("steady")
         if V > 0.0 and slope == 0.0 and self._steady_exactly(lnV):
             if math.isfinite(t_stop):
@@ -979,9 +982,10 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     V = positive("V", V)
-    if model.second_state is not None:
-        raise ValueError("limit_cycle does not support a second state variable (use simulate)")
     options = options or SolverOptions()
+    if model.second_state is not None and options.accelerate:
+        # the cycle map has two dimensions: no one-variable extrapolation
+        options = replace(options, accelerate=False)
     initial = (initial or InitialState()).resolved(InitialState.DEFAULT_PERTURBATION)
     started = time.perf_counter()
     protocol = Protocol.constant(V)
