@@ -213,3 +213,13 @@ def test_run_history_state_laws_and_damping_on_the_command_line(tmp_path):
                  "--out", str(out)]) == 2                                  # --Dc2 missing
     assert main(["run", "--k0", "0.01", *log, "--history", str(tmp_path / "nope.csv"),
                  "--t-end", "4", "--out", str(out)]) == 2
+
+
+def test_critical_and_sweep_with_radiation_damping(tmp_path):
+    out = tmp_path / "vc.csv"
+    log = ["--law", "log", "--b", "0.01", "--law-a", "0.005", "--a", "0.005", "--v0", "1",
+           "--Dc", "10", "--eta-rad", "1e-4"]
+    assert main(["critical", "--k0", "0.0004", *log, "--out", str(out)]) == 0
+    assert pd.read_csv(out).Vc[0] == pytest.approx(10.0, rel=1e-13)     # (b - a - k0 Dc)/eta
+    assert main(["sweep", "--k0", "0.0004", *log, "--V", "5,20", "--out", str(out)]) == 0
+    assert list(pd.read_csv(out).regime) == ["stick-slip", "steady"]
