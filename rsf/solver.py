@@ -571,7 +571,11 @@ class _SmoothEngine:
 
     def set_state(self, lv: float, q: float) -> None:
         """Restart at (ln v, q) (used by the cycle extrapolation); x follows the spring."""
-        self.y = np.array([lv, q, 0.0, self.y[3], self.y[4]])
+        y = self.y.copy()
+        y[0], y[1] = lv, q
+        if self.second is not None:         # the second state keeps its distance to steady
+            y[5] += q - self.y[1]
+        self.y = y
         self.y[2] = self.protocol.load_point(self.t) - self.spring_of(self.y) / self.model.k0
         self.at_root = True
         self.emit("restart")
