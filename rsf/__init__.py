@@ -28,6 +28,15 @@ from .laws import (
 )
 from .params import InitialState, Protocol, SolverOptions, SpringSlider, standard_rs
 from .reference import reference_cycle
+from .state_laws import (
+    AgingLaw,
+    CallableStateLaw,
+    NagataLaw,
+    PRZLaw,
+    SecondState,
+    SlipLaw,
+    StateLaw,
+)
 from .results import STATUS_MESSAGES, CycleResult, Event, Status, SweepResult, Trajectory
 from .solver import limit_cycle, simulate, sweep
 
@@ -51,6 +60,13 @@ __all__ = [
     "TabulatedLaw",
     "CallableLaw",
     "paper_mu_inf",
+    "StateLaw",
+    "AgingLaw",
+    "SlipLaw",
+    "PRZLaw",
+    "NagataLaw",
+    "CallableStateLaw",
+    "SecondState",
     "PAPER_A",
     "PAPER_B",
     "PAPER_DC",

@@ -578,27 +578,53 @@ def slide_events(y, e, p, c):
 @njit(cache=True, nogil=True)
 def rs_rhs(y, yp, p, c):
     r"""Spring-slider with a direct effect :math:`a > 0`:
-    :math:`\sigma = \mu_{ss}(u) + a\ln(v/u)` with :math:`u = D_c/\theta`.
+    :math:`\mu = \mu_{ss}(u) + a\ln(v/u)` with :math:`u = D_c/\theta`
+    (:func:`rs_rhs_dr` with the built-in state laws)."""
+    rs_rhs_dr(y, yp, p, c, 0.0)
 
-    Differentiating the friction at :math:`\sigma = k_0(X(t) - x)` gives
-    :math:`a\,\mathrm{d}\ln v/\mathrm{d}t = k_0(V - v) - (W + a)\,\mathrm{d}\ln\theta/\mathrm{d}t`
-    with :math:`\mathrm{d}\ln\theta/\mathrm{d}t = (u - v)/D_c` (aging, Eq. 8) or
-    :math:`-(v/D_c)\ln(v/u)` (Ruina slip law).  The independent variable is the
-    dimensionless :math:`s` with :math:`\mathrm{d}s = (v_s + v)\,\mathrm{d}t/D_c`, which
-    follows time in slow phases and slip in fast ones, so that the nearly instantaneous
-    slips of small :math:`a` stay resolvable; with :math:`f = v_s/(v_s + v)` (computed
-    from :math:`\ln v` without overflow) every rate below is bounded.
 
-    ``y = [w, r, x, I, t]`` with :math:`w = \ln(v/v_s)`, :math:`r = \ln(v_s/u)` (both 0 in
-    steady sliding at :math:`V = v_s`, so that event functions near it are not differences
-    of large numbers) and :math:`I = \int (\sigma - \mu_{ref})\,\mathrm{d}t`;
-    ``c = [K, V, Dc, a, state_law, v_s, ...]`` (``state_law`` 0 aging, 1 slip).
+@njit(cache=True, nogil=True)
+def rs_rhs_dr(y, yp, p, c, dr_user):
+    r"""Spring-slider with a direct effect :math:`a > 0`, optional radiation damping
+    :math:`\eta` and an optional second state variable.
+
+    Force balance :math:`k_0(X(t) - x) = \mu + \eta v` with
+    :math:`\mu = \mu_{ss}(u) + a\ln(v/u) + b_2\ln(v_0\theta_2/D_{c2})`,
+    :math:`u = D_c/\theta`.  Differentiating it gives
+
+    .. math::
+        (a + \eta v)\,\frac{\mathrm{d}\ln v}{\mathrm{d}t} = k_0(V - v)
+        - (W + a)\,\frac{\mathrm{d}\ln\theta}{\mathrm{d}t}
+        - b_2\,\frac{\mathrm{d}\ln\theta_2}{\mathrm{d}t},
+
+    with :math:`\mathrm{d}\ln\theta/\mathrm{d}t` from the state law (code ``c[4]``:
+    0 aging :math:`(u - v)/D_c`, 1 slip :math:`-(v/D_c)\ln(v/u)`, 2 PRZ
+    :math:`(u/2D_c)(1 - (v/u)^2)`, 3 Nagata: aging :math:`- (c/b)\,\dot\mu`, solved
+    together with the equation above since :math:`\dot\mu` holds :math:`\eta\dot v`;
+    4 ``dr_user``, computed outside).  The independent variable is the dimensionless
+    :math:`s` with :math:`\mathrm{d}s = (v_s + v)\,\mathrm{d}t/D_c`, which follows time
+    in slow phases and slip in fast ones, so that the nearly instantaneous slips of small
+    :math:`a` stay resolvable; with :math:`f = v_s/(v_s + v)` (computed from
+    :math:`\ln v` without overflow) every rate below is bounded.
+
+    ``y = [w, r, x, I, t(, q2)]`` with :math:`w = \ln(v/v_s)`, :math:`r = \ln(v_s/u)`,
+    :math:`q_2 = \ln(v_s\theta_2/D_{c2})` (all 0 in steady sliding at :math:`V = v_s`,
+    so that event functions near it are not differences of large numbers) and
+    :math:`I = \int (\mu - \mu_{ref})\,\mathrm{d}t`;
+    ``c = [K, V, Dc, a, state_law, v_s, ...events..., eta, c/b, b2, Dc/Dc2, ln(v0/v_s),
+    dV/dt, t_0]`` (indices 12 to 18; with a ramp :math:`V(t) = V + \dot V (t - t_0)`).
     """
     K = c[0]
     V = c[1]
+    if c[17] != 0.0:                 # a sampled history: V ramps linearly in t
+        V = max(V + c[17] * (y[4] - c[18]), 0.0)
     Dc = c[2]
     a = c[3]
+    code = c[4]
     vs = c[5]
+    eta = c[12]
+    cb = c[13]
+    b2 = c[14]
     w = y[0]
     r = y[1]
     if w > 0.0:
@@ -609,28 +635,64 @@ def rs_rhs(y, yp, p, c):
     g = 1.0 - f                      # v / (vs + v)
     er = math.exp(-r)                # u / vs
     mu, wk = law_eval(vs * er, p)
-    if c[4] == 0.0:
-        dr = er * f - g
+    if code == 0.0 or code == 3.0:
+        dr0 = er * f - g
+    elif code == 1.0:
+        dr0 = -g * (w + r)
+    elif code == 2.0:
+        dr0 = 0.5 * (er * f - g * math.exp(min(w + r, 700.0)))
     else:
-        dr = -g * (w + r)
+        dr0 = dr_user
+    dq2 = 0.0
+    mu2 = 0.0
+    if b2 > 0.0:
+        q2 = y[5]
+        ratio = c[15]
+        if code == 1.0:
+            dq2 = -ratio * g * (w + q2)
+        elif code == 2.0:
+            dq2 = ratio * 0.5 * (math.exp(-q2) * f - g * math.exp(min(w + q2, 700.0)))
+        else:
+            dq2 = ratio * (math.exp(-q2) * f - g)
+        mu2 = b2 * (q2 + c[16])
+    stress = K * ((V / vs) * f - g)  # d(spring force)/ds
+    damp = eta * vs * math.exp(min(w, 700.0)) if eta > 0.0 else 0.0   # eta v
+    wa = wk + a
+    if code == 3.0:
+        dw = (stress - wa * (dr0 - cb * stress) - b2 * dq2) / (a + damp + wa * cb * damp)
+        dr = dr0 - cb * (stress - damp * dw)
+    else:
+        dr = dr0
+        dw = (stress - wa * dr - b2 * dq2) / (a + damp)
     dt = Dc / vs * f
-    yp[0] = (K * ((V / vs) * f - g) - (wk + a) * dr) / a
+    yp[0] = dw
     yp[1] = dr
     yp[2] = Dc * g
-    yp[3] = (mu + a * (w + r)) * dt
+    yp[3] = (mu + a * (w + r) + mu2) * dt
     yp[4] = dt
+    if b2 > 0.0:
+        yp[5] = dq2
 
 
 @njit(cache=True, nogil=True)
 def rs_events(y, e, p, c):
     """Events of the a > 0 ODE: ``e[0]`` and ``e[1]`` ln(v/V) (sigma maximum when rising,
     minimum when falling), ``e[2]`` distance to the steady state minus s_tol, ``e[3]``
-    t - t_stop.  ``c[6:11] = [ln(V/v_s), ln(v_s/V), s_tol, steady_on, t_stop]``."""
-    if c[1] > 0.0:
+    t - t_stop, ``e[4]`` ln(v/v_max) (runaway); with a ramp ``c[17] != 0`` the extrema are
+    at v = V(t) and there is no steady state.
+    ``c[6:12] = [ln(V/v_s), ln(v_s/V), s_tol, steady_on, t_stop, ln(v_max/v_s)]``."""
+    if c[17] != 0.0:                 # a ramp: extrema of the spring force at v = V(t)
+        V = c[1] + c[17] * (y[4] - c[18])
+        e[0] = y[0] - math.log(V / c[5]) if V > 0.0 else 1.0
+        e[1] = e[0]
+        e[2] = 1.0
+    elif c[1] > 0.0:
         e[0] = y[0] - c[6]
         e[1] = e[0]
         if c[9] > 0.0:
             e[2] = abs(y[0] - c[6]) + abs(y[1] - c[7]) - c[8]
+            if c[14] > 0.0:
+                e[2] += abs(y[5] - c[7])
         else:
             e[2] = 1.0
     else:
@@ -638,6 +700,7 @@ def rs_events(y, e, p, c):
         e[1] = 1.0
         e[2] = 1.0
     e[3] = y[4] - c[10]
+    e[4] = y[0] - c[11]
 
 
 # --------------------------------------------------------------------------------------
@@ -645,7 +708,7 @@ def rs_events(y, e, p, c):
 # --------------------------------------------------------------------------------------
 KERNEL_NAMES = ("law_eval", "phi_w", "dphi", "phase_fn", "phase_dfn", "brentq", "first_root",
                 "stick_end", "slip_end", "decide", "slide_converges", "slide_rhs",
-                "slide_events", "rs_rhs", "rs_events")
+                "slide_events", "rs_rhs_dr", "rs_rhs", "rs_events")
 
 
 def kernel_namespace(law_eval_func=None, jit: bool = False) -> dict:

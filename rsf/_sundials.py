@@ -14,7 +14,7 @@ from typing import Callable, Sequence
 import numpy as np
 import sksundae as sun
 
-__all__ = ["OdeSolution", "integrate"]
+__all__ = ["OdeSolution", "integrate", "integrate_outputs"]
 
 
 @dataclass
@@ -93,3 +93,99 @@ def integrate(rhs: Callable[[float, np.ndarray, np.ndarray], None], y0: np.ndarr
     return OdeSolution(t=t, y=y, events=found, terminal_event=terminal_event,
                        status=int(sol.status), message=str(sol.message), success=bool(sol.success),
                        nfev=int(sol.nfev))
+
+
+def integrate_outputs(rhs: Callable[[float, np.ndarray, np.ndarray], None], y0: np.ndarray,
+                      t0: float, t1: float, *, out_index: int = 0,
+                      out_times: np.ndarray | None = None,
+                      events: Callable[[float, np.ndarray, np.ndarray], None] | None = None,
+                      terminal: Sequence[bool] = (), direction: Sequence[int] = (),
+                      rtol: float = 1e-10, atol: float | np.ndarray = 1e-12,
+                      method: str = "BDF", max_num_steps: int = 1_000_000,
+                      save_steps: bool = False) -> OdeSolution:
+    """Like :func:`integrate`, one CVODE step at a time under our own control, and also
+    stop at every time where ``y[out_index]`` reaches the next of ``out_times`` (sorted,
+    all beyond ``y0``): those points come back as events of index ``len(terminal)`` with
+    CVODE's own interpolated state at the root.
+
+    Stepping one internal step at a time lets the output event always target the next
+    pending time (one sign change per output: a step spanning several outputs cannot hide
+    them), and bounds the work: at most ``max_num_steps`` internal steps, and a run whose
+    step has fallen below the round-off of the independent variable (``t + h == t``, a
+    solution that blows up) stops with status -3 instead of stalling.  With ``save_steps``
+    every internal step is returned (``t``, ``y``), else the end points.
+    """
+    n_events = len(terminal)
+    out_times = np.ascontiguousarray(out_times if out_times is not None else [], dtype=float)
+    pending = [0]
+    n_out = out_times.size
+    has_out = n_out > 0
+    n_all = n_events + (1 if has_out else 0)
+    options: dict = dict(rtol=rtol, atol=atol, method=method, max_num_steps=int(max_num_steps))
+    if n_all:
+        if has_out:
+            def eventsfn(t, y, e):
+                if events is not None:
+                    events(t, y, e)
+                j = pending[0]
+                e[n_events] = y[out_index] - out_times[j] if j < n_out else -1.0
+        else:
+            def eventsfn(t, y, e):
+                events(t, y, e)
+        eventsfn.terminal = [bool(x) for x in terminal] + ([False] if has_out else [])
+        eventsfn.direction = [int(x) for x in direction] + ([1] if has_out else [])
+        options.update(eventsfn=eventsfn, num_events=n_all)
+    solver = sun.cvode.CVODE(rhs, **options)
+    y0 = np.ascontiguousarray(y0, dtype=float)
+    solver.init_step(t0, y0)
+    found: list[tuple[float, np.ndarray, int, int]] = []
+    terminal_event = None
+    t_now, y_now = t0, y0.copy()
+    ts, ys = [t0], [y0.copy()]
+    status, message, success, nfev = 0, "", True, 0
+    stalled = 0
+    eps = np.finfo(float).eps
+    for _ in range(int(max_num_steps)):
+        sol = solver.step(t1, method="onestep", tstop=t1)
+        status, message, success = int(sol.status), str(sol.message), bool(sol.success)
+        nfev = int(sol.nfev)
+        if not success:
+            break
+        t_prev = t_now
+        t_now = float(sol.t)
+        y_now = np.asarray(sol.y, dtype=float).copy()
+        if save_steps:
+            ts.append(t_now)
+            ys.append(y_now)
+        if status == 2:                                    # CV_ROOT_RETURN
+            i_ev = np.asarray(sol.i_events).reshape(-1, n_all)[-1]
+            for idx in np.flatnonzero(i_ev):
+                found.append((t_now, y_now.copy(), int(idx), int(np.sign(i_ev[idx]))))
+                if idx == n_events:
+                    pending[0] += 1
+                elif terminal[idx] and terminal_event is None:
+                    terminal_event = int(idx)
+            # forget the stored events: the next step reports only its own
+            eventsfn._i.clear()
+            eventsfn._t.clear()
+            eventsfn._y.clear()
+            if terminal_event is not None:
+                break
+        elif t_now - t_prev <= 8.0 * eps * max(abs(t_now), 1.0):
+            stalled += 1
+            if stalled >= 3:
+                status, success = -3, False
+                message = "step size below the round-off of the independent variable"
+                break
+        else:
+            stalled = 0
+        if status == 1 or t_now >= t1:                     # CV_TSTOP_RETURN
+            break
+    else:
+        status, message, success = -1, "Could not reach endpoint after 'max_num_steps'.", False
+    if save_steps:
+        t_arr, y_arr = np.array(ts), np.array(ys)
+    else:
+        t_arr, y_arr = np.array([t0, t_now]), np.vstack([y0, y_now])
+    return OdeSolution(t=t_arr, y=y_arr, events=found, terminal_event=terminal_event,
+                       status=status, message=message, success=success, nfev=nfev)

@@ -33,7 +33,8 @@ from ._validation import positive
 from .laws import HyperbolicLaw, LogLaw, SteadyStateLaw
 from .params import SolverOptions, SpringSlider
 
-__all__ = ["CriticalVelocity", "critical_velocity", "HopfFit", "hopf_scaling", "fit_power_law"]
+__all__ = ["CriticalVelocity", "critical_velocity", "HopfFit", "hopf_scaling", "fit_power_law",
+           "steady_jacobian", "stability_margin"]
 
 
 @dataclass(frozen=True)
@@ -89,15 +90,119 @@ class CriticalVelocity:
                               "V_lower": self.V_lower, "method": self.method, "status": self.status}])
 
 
+def steady_jacobian(model: SpringSlider, V: float) -> np.ndarray:
+    r"""Jacobian of the spring-slider linearised about steady sliding at ``V``, for
+    :math:`a > 0`, in the relative perturbations :math:`\xi = \delta v/V`,
+    :math:`\psi = \delta\theta/\theta` and the time :math:`\tau = Vt/D_c`
+    (``docs/rsf.md``, "Radiation damping"):
+
+    .. math::
+        \frac{\mathrm{d}}{\mathrm{d}\tau}\begin{pmatrix}\xi\\ \psi\end{pmatrix}
+        = \frac{1}{a + \eta V}\begin{pmatrix} W + a - K & W + a\\
+          -(a + \eta V) & -(a + \eta V)\end{pmatrix}
+          \begin{pmatrix}\xi\\ \psi\end{pmatrix}
+
+    (with a second state variable a 3 x 3 matrix, :func:`_two_state_jacobian`)
+    for the aging, slip and PRZ laws (they share the linearisation
+    :math:`\psi_\tau = -(\xi + \psi)`), with :math:`K = k_0 D_c`,
+    :math:`W = W(V)` and :math:`\eta = \eta_{rad}`: trace
+    :math:`(W - K - \eta V)/(a + \eta V)`, determinant :math:`K/(a + \eta V) > 0`.  The
+    Nagata law adds :math:`(c/b)(K\xi + \eta V\xi_\tau)` to :math:`\psi_\tau`.  For a
+    user law :math:`\psi_\tau = p\,\xi + q\,\psi` with :math:`p, q` the logarithmic
+    derivatives of :math:`(D_c/V)\,\dot\theta/\theta` (central differences of the
+    user's function), and the first row becomes
+    :math:`(-K - (W + a)p,\; -(W + a)q)/(a + \eta V)`.
+    """
+    from .state_laws import NAGATA, USER
+
+    V = positive("V", V)
+    if model.a == 0.0:
+        raise ValueError("steady_jacobian needs a direct effect a > 0")
+    if model.second_state is not None:
+        return _two_state_jacobian(model, V)
+    if model.state.code == USER:
+        return _user_jacobian(model, V)
+    K = model.K
+    a = model.a
+    W = float(model.law.weakening(np.array([V]))[0])
+    damp = model.eta_rad * V
+    Wa = W + a
+    kappa = 0.0
+    if model.state.code == NAGATA:
+        b = model.state.b if model.state.b is not None else model.law.b
+        kappa = model.state.c / b
+    D = a + damp * (1.0 + Wa * kappa)
+    j11 = (Wa - K * (1.0 + Wa * kappa)) / D
+    j12 = Wa / D
+    j21 = -1.0 + kappa * K + kappa * damp * j11
+    j22 = -1.0 + kappa * damp * j12
+    return np.array([[j11, j12], [j21, j22]])
+
+
+def _two_state_jacobian(model: SpringSlider, V: float) -> np.ndarray:
+    r"""3 x 3 Jacobian in :math:`(\xi, \psi_1, \psi_2)` for a second state variable:
+    :math:`\psi_{2,\tau} = -\rho(\xi + \psi_2)` with :math:`\rho = D_c/D_{c2}`, and
+    :math:`(a + \eta V)\xi_\tau = -K\xi + (W + a)(\xi + \psi_1) + b_2\rho(\xi + \psi_2)`."""
+    rho = model.Dc / model.second_state.Dc2
+    b2 = model.second_state.b2
+    W = float(model.law.weakening(np.array([V]))[0])
+    Wa = W + model.a
+    D = model.a + model.eta_rad * V
+    return np.array([[(-model.K + Wa + b2 * rho) / D, Wa / D, b2 * rho / D],
+                     [-1.0, -1.0, 0.0],
+                     [-rho, 0.0, -rho]])
+
+
+def _user_jacobian(model: SpringSlider, V: float) -> np.ndarray:
+    Dc = model.Dc
+    theta = Dc / V
+    func = model.state.func
+
+    def g(lv: float, lth: float) -> float:       # (Dc / V) d ln(theta)/dt
+        th = math.exp(lth)
+        return Dc / V * float(func(math.exp(lv), th)) / th
+
+    h = 1e-6
+    lv, lth = math.log(V), math.log(theta)
+    p = (g(lv + h, lth) - g(lv - h, lth)) / (2 * h)
+    q = (g(lv, lth + h) - g(lv, lth - h)) / (2 * h)
+    W = float(model.law.weakening(np.array([V]))[0])
+    D = model.a + model.eta_rad * V
+    Wa = W + model.a
+    return np.array([[(-model.K - Wa * p) / D, -Wa * q / D], [p, q]])
+
+
+def stability_margin(model: SpringSlider, V: float) -> float:
+    r"""Positive where steady sliding at ``V`` is linearly unstable, negative where it is
+    stable, zero at the Hopf bifurcation: :math:`W(V) - k_0 D_c - \eta_{rad}V` (the
+    trace of :func:`steady_jacobian` times :math:`a + \eta V`) for the aging, slip and
+    PRZ laws and for :math:`a = 0`; the trace of the Jacobian for the Nagata and user laws
+    when its determinant is positive (a saddle, determinant < 0, counts as unstable); the
+    largest real part of the eigenvalues with a second state variable."""
+    from .state_laws import NAGATA, USER
+
+    if model.second_state is not None:
+        return float(np.max(np.linalg.eigvals(steady_jacobian(model, V)).real))
+    if model.state.code in (NAGATA, USER) and model.a > 0.0:
+        J = steady_jacobian(model, V)
+        det = float(np.linalg.det(J))
+        return float(np.trace(J)) if det > 0.0 else abs(det) + 1e-300   # a saddle: unstable
+    W = float(model.law.weakening(np.array([V]))[0])
+    return W - model.K - model.eta_rad * V
+
+
 def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: float = 0.06, *,
                       v_min: float = 1e-12, v_max: float = 1e12) -> CriticalVelocity:
-    r"""Where steady sliding loses stability: the roots of :math:`k_0 D_c = W(V)`.
+    r"""Where steady sliding loses stability: the roots of :math:`k_0 D_c = W(V)`, or with
+    radiation damping :math:`\eta_{rad}` (a :class:`~rsf.params.SpringSlider` given) of
+    :math:`k_0 D_c + \eta_{rad} V = W(V)`; for the Nagata law the zeros of the trace of
+    :func:`steady_jacobian`.
 
     Parameters
     ----------
     law : SteadyStateLaw, optional
         Default: the paper's Eq. (10).  (Also accepts a :class:`~rsf.params.SpringSlider`
-        as first argument, whose law, k0 and Dc are then used.)
+        as first argument, whose law, k0, Dc, state law and eta_rad are then used.)
     k0, Dc : float
         Driving stiffness and critical slip distance, > 0.
     v_min, v_max : float
@@ -109,6 +214,9 @@ def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: f
     """
     if isinstance(law, SpringSlider):
         model = law
+        if (model.eta_rad > 0.0 or model.second_state is not None
+                or (model.state.code in (3, 4) and model.a > 0.0)):
+            return _critical_velocity_scan(model, v_min, v_max)
         law, k0, Dc = model.law, model.k0, model.Dc
     if law is None:
         law = HyperbolicLaw()
@@ -157,6 +265,46 @@ def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: f
             probe = math.sqrt(lo * hi)
         if float(law.weakening(np.array([probe]))[0]) > K:
             unstable.append((lo, hi))
+    if not unstable:
+        return CriticalVelocity(k0, Dc, math.nan, math.nan, tuple(roots), (), "scan")
+    lo, hi = unstable[-1]
+    return CriticalVelocity(k0, Dc, hi, lo, tuple(roots), tuple(unstable), "scan")
+
+
+def _critical_velocity_scan(model: SpringSlider, v_min: float, v_max: float) -> CriticalVelocity:
+    """The roots of :func:`stability_margin` in V, bracketed on a log grid and refined by
+    brentq to machine precision."""
+    v_min = positive("v_min", v_min)
+    v_max = positive("v_max", v_max)
+    if v_max <= v_min:
+        raise ValueError(f"v_max must be > v_min = {v_min!r}, got {v_max!r}")
+
+    def margin_log(x: float) -> float:
+        return stability_margin(model, math.exp(x))
+
+    v = np.geomspace(v_min, v_max, 2401)
+    f = np.array([stability_margin(model, float(x)) for x in v])
+    sign = np.sign(f)
+    roots = [float(v[i]) for i in np.flatnonzero(sign == 0.0)
+             if 0 < i < v.size - 1 and sign[i - 1] * sign[i + 1] < 0]   # a root on the grid
+    roots += [math.exp(brentq(margin_log, math.log(v[i]), math.log(v[i + 1]), xtol=1e-15,
+                              rtol=4 * np.finfo(float).eps))
+              for i in np.flatnonzero(sign[:-1] * sign[1:] < 0)]
+    roots.sort()
+    edges = [0.0] + roots + [math.inf]
+    unstable = []
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        if lo == 0.0 and hi == math.inf:
+            probe = 1.0
+        elif lo == 0.0:
+            probe = hi / 10.0
+        elif hi == math.inf:
+            probe = lo * 10.0
+        else:
+            probe = math.sqrt(lo * hi)
+        if stability_margin(model, probe) > 0.0:
+            unstable.append((lo, hi))
+    k0, Dc = model.k0, model.Dc
     if not unstable:
         return CriticalVelocity(k0, Dc, math.nan, math.nan, tuple(roots), (), "scan")
     lo, hi = unstable[-1]

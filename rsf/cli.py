@@ -27,6 +27,7 @@ from .analysis import critical_velocity
 from .laws import PAPER_A, PAPER_B, PAPER_DC, HyperbolicLaw, LogLaw, TabulatedLaw, ViscoelasticLaw
 from ._validation import positive
 from .params import Protocol, SolverOptions, SpringSlider
+from .state_laws import NagataLaw, SecondState
 from .solver import simulate, sweep
 
 __all__ = ["main", "build_parser"]
@@ -105,8 +106,19 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
                    help="steady-state law: hyperbolic = Eq. (10) A/(v+B) + mu_inf (default); "
                         "viscoelastic = Eq. (4); log = Eq. (9), mu0 + (a-b) ln(v/v0); "
                         "table = PCHIP interpolation of a CSV (--table)")
-    g.add_argument("--state-law", choices=("aging", "slip"), default="aging",
-                   help="state evolution: aging (Eq. 8, default) or Ruina slip law (needs --a > 0)")
+    g.add_argument("--state-law", choices=("aging", "slip", "prz", "nagata"), default="aging",
+                   help="state evolution: aging (Eq. 8, default), Ruina slip, Perrin-Rice-Zheng "
+                        "(prz) or Nagata; all but aging need --a > 0")
+    g.add_argument("--nagata-c", type=float, default=2.0,
+                   help="Nagata's stress-rate coefficient c >= 0 (with --state-law nagata; "
+                        "b from the log law, default 2)")
+    g.add_argument("--b2", type=float, default=None,
+                   help="second state variable: its evolution effect b2 > 0 (log law, a > 0)")
+    g.add_argument("--Dc2", type=float, default=None,
+                   help="second state variable: its critical slip distance Dc2 > 0")
+    g.add_argument("--eta-rad", type=float, default=0.0,
+                   help="radiation damping eta_rad >= 0: k0 (X - x) = mu + eta_rad v (needs a > 0; "
+                        "default 0, the paper's model)")
     g.add_argument("--a", type=float, default=None,
                    help="direct effect a >= 0 (default: the law's a for --law log, else 0, "
                         "the paper's model with stick, slide and instantaneous slip)")
@@ -146,6 +158,13 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--max-cycles", type=int, default=20000, help="give up after this many cycles")
     g.add_argument("--no-accelerate", action="store_true",
                    help="simulate every cycle of the transient (no Aitken extrapolation)")
+    g.add_argument("--v-max", type=float, default=None,
+                   help="runaway bound on the slip velocity (a > 0): stop with status RUNAWAY "
+                        "when v passes it (default 1e3 x max V for the log law, none otherwise; "
+                        "inf: off)")
+    g.add_argument("--max-rhs-evals", type=int, default=20_000_000,
+                   help="step budget: stop after this many right-hand-side evaluations "
+                        "(default 20000000)")
 
 
 def _law(args: argparse.Namespace, k0: float):
@@ -164,12 +183,22 @@ def _law(args: argparse.Namespace, k0: float):
 
 
 def _model(args: argparse.Namespace, k0: float) -> SpringSlider:
-    return SpringSlider(law=_law(args, k0), k0=k0, Dc=args.Dc, a=args.a, state_law=args.state_law)
+    state_law: object = args.state_law
+    if state_law == "nagata":
+        state_law = NagataLaw(c=args.nagata_c)
+    second = None
+    if (args.b2 is None) != (args.Dc2 is None):
+        raise ValueError("give both --b2 and --Dc2 for a second state variable")
+    if args.b2 is not None:
+        second = SecondState(args.b2, args.Dc2)
+    return SpringSlider(law=_law(args, k0), k0=k0, Dc=args.Dc, a=args.a, state_law=state_law,
+                        second_state=second, eta_rad=args.eta_rad)
 
 
 def _options(args: argparse.Namespace) -> SolverOptions:
     return SolverOptions(rtol=args.rtol, atol=args.atol, cycle_rtol=args.cycle_rtol,
-                         max_cycles=args.max_cycles, accelerate=not args.no_accelerate)
+                         max_cycles=args.max_cycles, accelerate=not args.no_accelerate,
+                         v_max=args.v_max, max_rhs_evals=args.max_rhs_evals)
 
 
 def _write(frame, out: str | None) -> None:
@@ -227,20 +256,38 @@ def build_parser() -> argparse.ArgumentParser:
                     help="velocity steps V1:T1,V2:T2,...,Vn (velocity:duration, last open-ended)")
     pr.add_argument("--shs", type=float, nargs=3, metavar=("V", "SLIDE", "HOLD"), default=None,
                     help="slide-hold-slide: slide at V for SLIDE, hold for HOLD, slide again")
+    pr.add_argument("--history", default=None,
+                    help="sampled load-point velocity V(t): a CSV file with columns t and V "
+                         "(t from 0, strictly increasing), linear between the samples (a > 0)")
     pr.add_argument("--t-end", type=float, required=True, help="end time > 0")
     pr.add_argument("--out", required=True, help="output CSV for the time series")
     pr.add_argument("--events", default=None, help="output CSV for the events t, kind, sigma, theta, x")
+    pr.add_argument("--t-eval", type=_floats, default=None,
+                    help="output times t1,t2,... (strictly increasing, in [0, t-end]): samples "
+                         "exactly there instead of at every integrator step")
+    pr.add_argument("--t-eval-n", type=int, default=None,
+                    help="output at N equally spaced times from 0 to t-end")
     _add_model_options(pr)
     _add_solver_options(pr)
     return parser
 
 
 def _protocol(args: argparse.Namespace) -> tuple[float | None, Protocol | None]:
-    given = [x is not None for x in (args.V, args.steps, args.shs)]
+    given = [x is not None for x in (args.V, args.steps, args.shs, args.history)]
     if sum(given) != 1:
-        raise ValueError("give exactly one of --V, --steps, --shs")
+        raise ValueError("give exactly one of --V, --steps, --shs, --history")
     if args.V is not None:
         return args.V, None
+    if args.history is not None:
+        import pandas as pd
+
+        try:
+            frame = pd.read_csv(args.history)
+        except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+            raise ValueError(f"--history {args.history!r} cannot be read: {exc}") from None
+        if not {"t", "V"} <= set(frame.columns):
+            raise ValueError(f"--history needs columns t and V, got {list(frame.columns)}")
+        return None, Protocol.sampled(frame["t"].to_numpy(float), frame["V"].to_numpy(float))
     if args.shs is not None:
         V, slide, hold = args.shs
         return None, Protocol.slide_hold_slide(V, slide, hold)
@@ -293,7 +340,15 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return 3
             return 0
         V, protocol = _protocol(args)
-        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options)
+        if args.t_eval is not None and args.t_eval_n is not None:
+            raise ValueError("give at most one of --t-eval and --t-eval-n")
+        t_eval = args.t_eval
+        if args.t_eval_n is not None:
+            if not 2 <= args.t_eval_n <= 10_000_000:
+                raise ValueError(f"--t-eval-n must lie in [2, 10000000], got {args.t_eval_n}")
+            t_eval = np.linspace(0.0, args.t_end, args.t_eval_n)
+        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
+                        t_eval=t_eval)
         _write(traj.to_frame(), args.out)
         if args.events:
             _write(traj.events_frame(), args.events)

@@ -21,6 +21,15 @@ import numpy as np
 
 from ._validation import choice, nonnegative, positive, positive_int
 from .laws import PAPER_DC, HyperbolicLaw, LogLaw, SteadyStateLaw
+from .state_laws import (
+    AgingLaw,
+    CallableStateLaw,
+    NagataLaw,
+    PRZLaw,
+    SecondState,
+    SlipLaw,
+    state_law_from,
+)
 
 __all__ = ["SpringSlider", "Protocol", "InitialState", "SolverOptions", "standard_rs"]
 
@@ -44,17 +53,30 @@ class SpringSlider:
         :class:`~rsf.laws.LogLaw` (Eq. 7), otherwise 0 (the paper's model, Eq. 11).
         With :math:`a = 0` the motion splits into stick, slide and instantaneous slip; with
         :math:`a > 0` it is a regular ODE.
-    state_law : {'aging', 'slip'}
-        Eq. (8) (Dieterich aging) or the Ruina slip law
-        :math:`\dot\theta = -(\theta v/D_c)\ln(\theta v/D_c)`; the slip law needs
-        :math:`a > 0` (with :math:`a = 0` the instantaneous slip is undefined for it).
+    state_law : {'aging', 'slip', 'prz', 'nagata'}, StateLaw or callable
+        The state evolution (:mod:`rsf.state_laws`): Eq. (8) (Dieterich aging), the Ruina
+        slip law :math:`\dot\theta = -(\theta v/D_c)\ln(\theta v/D_c)`,
+        Perrin-Rice-Zheng, Nagata, or a callable ``f(v, theta) -> dtheta/dt``.  All but
+        the aging law need :math:`a > 0` (with :math:`a = 0` the instantaneous slip is
+        defined for the aging law only).  ``model.state`` is the resolved
+        :class:`~rsf.state_laws.StateLaw`.
+    second_state : SecondState or None
+        A second state variable :math:`b_2\ln(v_0\theta_2/D_{c2})` (log law, a > 0; the
+        aging, slip or PRZ law).
+    eta_rad : float
+        Radiation damping :math:`\eta_{rad} \ge 0` (QDYN's quasi-dynamic term; needs
+        :math:`a > 0`): the force balance reads
+        :math:`k_0(X(t) - x) = \mu(v, \theta) + \eta_{rad}\,v` (with :math:`F_N = 1`).
+        Default 0, the paper's model.
     """
 
     law: SteadyStateLaw = field(default_factory=HyperbolicLaw)
     k0: float = 0.01
     Dc: float = PAPER_DC
     a: float | None = None
-    state_law: str = "aging"
+    state_law: object = "aging"
+    second_state: SecondState | None = None
+    eta_rad: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.law, SteadyStateLaw):
@@ -68,10 +90,36 @@ class SpringSlider:
         if a is None:
             a = self.law.a if isinstance(self.law, LogLaw) else 0.0
         object.__setattr__(self, "a", nonnegative("a", a))
-        choice("state_law", self.state_law, ("aging", "slip"))
-        if self.state_law == "slip" and self.a == 0.0:
-            raise ValueError("state_law='slip' needs a direct effect a > 0 (with a = 0 the "
-                             "instantaneous slip of the slip law is undefined); got a = 0")
+        state = state_law_from(self.state_law)
+        object.__setattr__(self, "state", state)
+        if isinstance(self.state_law, str):
+            pass
+        elif isinstance(state, (AgingLaw, SlipLaw, PRZLaw)) and state == type(state)():
+            object.__setattr__(self, "state_law", state.name)
+        if isinstance(state, CallableStateLaw):
+            rate_ss = state.rate(1.0, self.Dc, self.Dc)
+            scale = max(abs(state.rate(1.0, 2.0 * self.Dc, self.Dc)), 1e-300)
+            if not abs(rate_ss) <= 1e-9 * scale:
+                raise ValueError(f"a user state law must have its steady state at theta = Dc/v "
+                                 f"(the friction law assumes it): f(1, Dc) = {rate_ss!r}, not 0")
+        if state.code != AgingLaw.code and self.a == 0.0:
+            raise ValueError(f"state_law={state.name!r} needs a direct effect a > 0 (with a = 0 "
+                             f"the instantaneous slip is defined for the aging law only); got a = 0")
+        if isinstance(state, NagataLaw) and state.b is None and not isinstance(self.law, LogLaw):
+            raise ValueError("NagataLaw(b=None) takes b from a LogLaw; give NagataLaw(c, b=...) "
+                             "for another steady-state law")
+        eta = nonnegative("eta_rad", self.eta_rad)
+        object.__setattr__(self, "eta_rad", eta)
+        if eta > 0.0 and self.a == 0.0:
+            raise ValueError("eta_rad > 0 needs a direct effect a > 0; got a = 0")
+        if self.second_state is not None:
+            if not isinstance(self.second_state, SecondState):
+                raise ValueError(f"second_state must be an rsf.SecondState, got {self.second_state!r}")
+            if not isinstance(self.law, LogLaw) or self.a == 0.0:
+                raise ValueError("second_state needs the log law (LogLaw) and a direct effect a > 0")
+            if state.code not in (AgingLaw.code, SlipLaw.code, PRZLaw.code):
+                raise ValueError(f"second_state works with the aging, slip or PRZ law, "
+                                 f"not {state.name!r}")
 
     @property
     def K(self) -> float:
@@ -85,34 +133,47 @@ class SpringSlider:
 
     def describe(self) -> dict[str, float | str]:
         """Parameters as a flat dict (for tables)."""
-        out: dict[str, float | str] = {"k0": self.k0, "Dc": self.Dc, "a": self.a,
-                                       "state_law": self.state_law}
+        out: dict[str, float | str] = {"k0": self.k0, "Dc": self.Dc, "a": self.a}
+        out.update(self.state.describe())
+        if self.second_state is not None:
+            out.update(b2=self.second_state.b2, Dc2=self.second_state.Dc2)
+        if self.eta_rad > 0.0:
+            out["eta_rad"] = self.eta_rad
         out.update(self.law.describe())
         return out
 
 
 def standard_rs(mu0: float = 0.6, a: float = 0.01, b: float = 0.015, Dc: float = 1e-5,
-                k0: float = 1e3, v0: float = 1e-6, state_law: str = "aging") -> SpringSlider:
-    r"""The classic rate-and-state spring-slider (Eq. 7 with Eq. 8 or the slip law):
+                k0: float = 1e3, v0: float = 1e-6, state_law: object = "aging",
+                second_state: SecondState | None = None, eta_rad: float = 0.0) -> SpringSlider:
+    r"""The classic rate-and-state spring-slider (Eq. 7 with a state law of
+    :mod:`rsf.state_laws`):
 
-    .. math:: \mu = \mu_0 + a\ln(v/v_0) + b\ln(\theta v_0/D_c).
+    .. math:: \mu = \mu_0 + a\ln(v/v_0) + b\ln(\theta v_0/D_c)
+              \;[+\, b_2\ln(\theta_2 v_0/D_{c2})].
 
     Defaults are laboratory-like (SI units: m, s), as in rsfmodel's examples.
     """
     return SpringSlider(law=LogLaw(mu0=mu0, a=a, b=b, v0=v0), k0=k0, Dc=Dc, a=a,
-                        state_law=state_law)
+                        state_law=state_law, second_state=second_state, eta_rad=eta_rad)
 
 
 @dataclass(frozen=True, eq=False)
 class Protocol:
-    r"""Piecewise-constant load-point velocity: ``velocities[i]`` from ``times[i]`` to
-    ``times[i + 1]`` (the last one forever).  ``times[0]`` must be 0.
+    r"""Load-point velocity history :math:`V(t)`.
 
-    Build it with :meth:`constant`, :meth:`velocity_steps` or :meth:`slide_hold_slide`.
+    With ``interpolation='previous'`` (default) it is piecewise constant:
+    ``velocities[i]`` from ``times[i]`` to ``times[i + 1]`` (the last one forever); with
+    ``'linear'`` it is the piecewise-linear interpolation of the samples (constant after
+    the last one), a sampled history.  ``times[0]`` must be 0.
+
+    Build it with :meth:`constant`, :meth:`velocity_steps`, :meth:`slide_hold_slide` or
+    :meth:`sampled`.
     """
 
     times: np.ndarray
     velocities: np.ndarray
+    interpolation: str = "previous"
 
     def __post_init__(self) -> None:
         times = np.atleast_1d(np.asarray(self.times, dtype=float)).copy()
@@ -126,10 +187,43 @@ class Protocol:
             raise ValueError("times must be finite and strictly increasing")
         if not np.all(np.isfinite(vel)) or np.any(vel < 0.0):
             raise ValueError("velocities must be finite and >= 0")
+        choice("interpolation", self.interpolation, ("previous", "linear"))
         times.setflags(write=False)
         vel.setflags(write=False)
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "velocities", vel)
+        # load-point displacement at each sample time
+        dt = np.diff(times)
+        if self.interpolation == "linear":
+            steps = 0.5 * dt * (vel[:-1] + vel[1:])
+        else:
+            steps = dt * vel[:-1]
+        xs = np.concatenate([[0.0], np.cumsum(steps)])
+        xs.setflags(write=False)
+        object.__setattr__(self, "_x_at_times", xs)
+
+    @classmethod
+    def sampled(cls, times: Sequence[float], velocities: Sequence[float]) -> Protocol:
+        r"""A sampled history :math:`V(t)`: linear between the samples (``times[0] = 0``,
+        strictly increasing; velocities >= 0), constant after the last one.  The load
+        point :math:`X(t) = \int_0^t V` is then exact (piecewise quadratic)."""
+        return cls(np.asarray(times, dtype=float), np.asarray(velocities, dtype=float),
+                   interpolation="linear")
+
+    @property
+    def is_linear(self) -> bool:
+        """Whether V(t) ramps linearly between samples (a sampled history)."""
+        return self.interpolation == "linear" and self.times.size > 1
+
+    def slope_at(self, t: float) -> float:
+        """dV/dt on the sample interval that starts at or before ``t`` (0 for steps)."""
+        if not self.is_linear:
+            return 0.0
+        i = int(np.searchsorted(self.times, t, side="right")) - 1
+        if i < 0 or i >= self.times.size - 1:
+            return 0.0
+        return float((self.velocities[i + 1] - self.velocities[i])
+                     / (self.times[i + 1] - self.times[i]))
 
     @classmethod
     def constant(cls, V: float) -> Protocol:
@@ -160,6 +254,8 @@ class Protocol:
         """The load-point velocity at time ``t`` (right-continuous)."""
         if self.times.size == 1:
             return float(self.velocities[0])
+        if self.is_linear:
+            return float(np.interp(t, self.times, self.velocities))
         i = int(np.searchsorted(self.times, t, side="right")) - 1
         return float(self.velocities[max(i, 0)])
 
@@ -176,8 +272,11 @@ class Protocol:
             return float(self.velocities[0]) * t
         i = int(np.searchsorted(self.times, t, side="right")) - 1
         i = max(i, 0)
-        dt = np.diff(self.times[: i + 1])
-        return float(np.dot(dt, self.velocities[:i]) + self.velocities[i] * (t - self.times[i]))
+        tau = t - self.times[i]
+        x = float(self._x_at_times[i]) + float(self.velocities[i]) * tau   # type: ignore[attr-defined]
+        if self.is_linear:
+            x += 0.5 * self.slope_at(t) * tau * tau
+        return x
 
     @property
     def is_constant(self) -> bool:
@@ -197,13 +296,26 @@ class InitialState:
     sigma : float or None
         Spring force (for :math:`a = 0`: must be finite; above the threshold the run starts
         with a slip).
-    perturbation : float
-        Relative offset of the default theta from steady state, > -1 (default 1e-3).
+    perturbation : float or None
+        Relative offset of the default theta from steady state, > -1.  ``None`` (default):
+        0 (the exact steady state) for :func:`~rsf.simulate` with a velocity-step,
+        slide-hold-slide or sampled protocol, 1e-3 for constant driving and for the
+        limit-cycle searches (:func:`~rsf.limit_cycle`, :func:`~rsf.sweep`), where the
+        perturbation lets an unstable steady state depart.
     """
 
     theta: float | None = None
     sigma: float | None = None
-    perturbation: float = 1e-3
+    perturbation: float | None = None
+
+    #: The perturbation used when none is given and the run looks for an attractor.
+    DEFAULT_PERTURBATION = 1e-3
+
+    def resolved(self, perturbation: float) -> "InitialState":
+        """A copy with ``perturbation`` set to the given default if it is None."""
+        if self.perturbation is not None:
+            return self
+        return InitialState(theta=self.theta, sigma=self.sigma, perturbation=perturbation)
 
     def __post_init__(self) -> None:
         if self.theta is not None:
@@ -213,6 +325,8 @@ class InitialState:
             if not math.isfinite(s):
                 raise ValueError(f"sigma must be a finite number, got {self.sigma!r}")
             object.__setattr__(self, "sigma", s)
+        if self.perturbation is None:
+            return
         pert = float(self.perturbation)
         if not (math.isfinite(pert) and pert > -1.0):
             raise ValueError(f"perturbation must be a finite number > -1, got {self.perturbation!r}")
@@ -246,6 +360,18 @@ class SolverOptions:
         CVODE method for the slide phases (default 'Adams'; the a > 0 ODE always uses BDF).
     max_num_steps : int
         CVODE steps allowed per output interval (default 1,000,000).
+    v_max : float or None
+        Runaway bound (:math:`a > 0`): a run stops with status ``RUNAWAY`` as soon as the
+        slip velocity passes ``v_max``.  ``None`` (default): :math:`10^3 \max V` (the
+        largest load-point velocity of the protocol) when the model has a
+        :class:`~rsf.laws.LogLaw` (classical rate and state, where a slip this fast
+        without radiation damping is a finite-time blow-up), no bound for the other laws
+        (their weakening vanishes at high speed and slips at :math:`v/V \sim 10^{50}`
+        still arrest).  Give ``math.inf`` to switch the bound off.
+    max_rhs_evals : int
+        Step budget: a run (one :func:`~rsf.simulate` or :func:`~rsf.limit_cycle` call)
+        stops with status ``STEP_BUDGET`` after this many right-hand-side evaluations of
+        CVODE in total (default 20,000,000, minutes of run time), so that no input hangs.
     """
 
     rtol: float = 1e-10
@@ -256,6 +382,8 @@ class SolverOptions:
     accelerate: bool = True
     method: str = "Adams"
     max_num_steps: int = 1_000_000
+    v_max: float | None = None
+    max_rhs_evals: int = 20_000_000
 
     def __post_init__(self) -> None:
         from ._validation import in_range
@@ -269,3 +397,17 @@ class SolverOptions:
         if not isinstance(self.accelerate, bool):
             raise ValueError(f"accelerate must be True or False, got {self.accelerate!r}")
         choice("method", self.method, ("Adams", "BDF"))
+        if self.v_max is not None:
+            v_max = _as_positive_or_inf("v_max", self.v_max)
+            object.__setattr__(self, "v_max", v_max)
+        object.__setattr__(self, "max_rhs_evals", positive_int("max_rhs_evals", self.max_rhs_evals))
+
+
+def _as_positive_or_inf(name: str, value: object) -> float:
+    try:
+        result = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number > 0 (or inf), got {value!r}") from None
+    if not result > 0.0:   # also rejects nan
+        raise ValueError(f"{name} must be a number > 0 (or inf), got {value!r}")
+    return result

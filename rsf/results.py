@@ -34,6 +34,7 @@ class Status:
     RUNAWAY = -3          #: a slip that never arrests (unbounded weakening)
     SOLVER_FAILED = -4    #: CVODE or a root search failed
     DEGENERATE = -5       #: repeated zero-length phases at a degenerate point
+    STEP_BUDGET = -6      #: the step budget (SolverOptions.max_rhs_evals) ran out
 
 
 STATUS_MESSAGES: dict[int, str] = {
@@ -42,9 +43,10 @@ STATUS_MESSAGES: dict[int, str] = {
     Status.CONVERGED: "limit cycle converged",
     Status.MAX_CYCLES: "limit cycle not converged within max_cycles",
     Status.MAX_EVENTS: "too many events",
-    Status.RUNAWAY: "runaway slip: the slip never arrests (weakening exceeds the spring)",
+    Status.RUNAWAY: "runaway slip: the slip velocity blows up (weakening exceeds the spring)",
     Status.SOLVER_FAILED: "the integrator or a root search failed",
     Status.DEGENERATE: "repeated zero-length phases at a degenerate (tangent) point",
+    Status.STEP_BUDGET: "the step budget (max_rhs_evals) ran out",
 }
 
 
@@ -72,7 +74,9 @@ class Trajectory:
     Attributes
     ----------
     t, x, sigma, theta, v : ndarray
-        Samples (a slip appears as two samples at the same time).
+        Samples (a slip appears as two samples at the same time), at the integrator's steps
+        or at ``t_eval``.  ``sigma`` is the friction; with radiation damping the spring
+        force is ``sigma + eta_rad * v``.
     events : list of Event
         Every event of the run.
     status : int

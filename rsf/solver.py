@@ -25,14 +25,17 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Iterable
 
 import numpy as np
 
 from . import _kernels
-from ._sundials import OdeSolution, integrate
+from ._sundials import OdeSolution, integrate, integrate_outputs
 from ._validation import positive
+from .laws import LogLaw
+from .analysis import stability_margin
+from .state_laws import NAGATA, USER
 from .params import InitialState, Protocol, SolverOptions, SpringSlider
 from .results import STATUS_MESSAGES, CycleResult, Event, Status, SweepResult, Trajectory
 
@@ -44,6 +47,7 @@ _THETA_FLOOR = 1e-250   # smallest theta resolved, in units of Dc (slips level o
 _ZERO_PHASES = 20       # consecutive zero-length phases before giving up
 _TAU_CHUNK = 1e4        # length of one CVODE run in the slide time tau (and in units of
                         # the natural time scale for the a > 0 ODE)
+_RUNAWAY_FACTOR = 1e3   # default runaway bound: v_max = 1e3 max V (LogLaw models)
 
 
 class _Kernels:
@@ -72,7 +76,7 @@ class _Samples:
     v: list = field(default_factory=list)
 
     def add(self, t, x, sigma, theta, v) -> None:
-        self.t.append(np.atleast_1d(np.asarray(t, dtype=float)))
+        self.t.append(np.atleast_1d(np.array(t, dtype=float, copy=True)))
         n = self.t[-1].size
         for name, val in (("x", x), ("sigma", sigma), ("theta", theta), ("v", v)):
             getattr(self, name).append(np.broadcast_to(np.asarray(val, dtype=float), (n,)).copy())
@@ -90,12 +94,14 @@ class _PhaseEngine:
     """Event-driven integration of the a = 0 model (one phase per :meth:`step`)."""
 
     def __init__(self, model: SpringSlider, protocol: Protocol, options: SolverOptions,
-                 record: bool, stop_at_steady: bool) -> None:
+                 record: bool, stop_at_steady: bool, t_eval: np.ndarray | None = None) -> None:
         self.model = model
         self.protocol = protocol
         self.options = options
         self.record = record
         self.stop_at_steady = stop_at_steady
+        self.t_eval = t_eval
+        self.next_out = 0
         self.p = model.law.kernel_params
         self.mu_ref = model.law.mu_ref
         self.k = _Kernels(model.law)
@@ -136,8 +142,20 @@ class _PhaseEngine:
         return ev
 
     def sample_now(self, v: float = 0.0) -> None:
-        if self.record:
+        if not self.record:
+            return
+        if self.t_eval is None:
             self.samples.add(self.t, self.x, self.mu_ref + self.sigma, self.theta, v)
+            return
+        te = self.t_eval        # only the requested times that fall on this instant
+        while self.next_out < te.size and te[self.next_out] <= self.t:
+            if te[self.next_out] < self.t * (1.0 - 1e-14) - 1e-300:
+                logger.warning("t_eval point %.17g skipped (passed over at t = %.17g)",
+                               te[self.next_out], self.t)
+            else:
+                self.samples.add(te[self.next_out], self.x, self.mu_ref + self.sigma,
+                                 self.theta, v)
+            self.next_out += 1
 
     def decide(self) -> int:
         return int(self.k.decide(self.p, self.theta, self.K, self.velocity(), self.Dc))
@@ -147,7 +165,7 @@ class _PhaseEngine:
         if initial.theta is not None:
             theta = initial.theta
         elif V0 > 0.0:
-            theta = self.Dc / V0 * (1.0 + initial.perturbation)
+            theta = self.Dc / V0 * (1.0 + (initial.perturbation or 0.0))
         else:
             raise ValueError("initial.theta is required when the driving starts with V = 0")
         self.theta = theta
@@ -182,7 +200,20 @@ class _PhaseEngine:
             ev = self._slip()
         else:
             ev = self._slide(t_end)
+        if self.t_eval is not None:
+            self.sample_now(self.slip_rate())
         return ev
+
+    def slip_rate(self) -> float:
+        """The slip velocity in the current phase (inf for a slip)."""
+        if self.phase == _kernels.STICK:
+            return 0.0
+        if self.phase == _kernels.SLIP:
+            return math.inf
+        u = self.Dc / self.theta
+        w = float(self.law_fn(u, self.p)[1])
+        d = self.K - w
+        return (self.K * self.velocity() - u * w) / d if d > 0.0 else math.inf
 
     def _zero_guard(self, duration: float) -> None:
         if duration == 0.0:
@@ -205,7 +236,13 @@ class _PhaseEngine:
         if flag == _kernels.FAILED:
             raise _Stop(Status.SOLVER_FAILED, f"stick-end search failed at t = {self.t:g}")
         sigma_new = self.sigma + self.k0 * V * dt
-        if self.record and dt > 0.0:
+        if self.record and self.t_eval is not None:
+            tt = self._pending_upto(self.t + dt)       # closed form: exact samples
+            ts = tt - self.t
+            if ts.size:
+                self.samples.add(tt, self.x, self.mu_ref + self.sigma + self.k0 * V * ts,
+                                 self.theta + ts, 0.0)
+        elif self.record and dt > 0.0:
             ts = np.linspace(0.0, dt, 17)[1:]
             self.samples.add(self.t + ts, self.x, self.mu_ref + self.sigma + self.k0 * V * ts,
                              self.theta + ts, 0.0)
@@ -266,22 +303,52 @@ class _PhaseEngine:
         return self.emit({_kernels.STICK: "slip->stick", _kernels.SLIDE: "slip->slide",
                           _kernels.SLIP: "slip->slip"}[nxt])
 
-    def _integrate_chunks(self, rhs, events, atol) -> OdeSolution:
+    def _pending_upto(self, t_hi: float) -> np.ndarray:
+        """The pending t_eval points up to ``t_hi`` (inclusive), marked as done."""
+        te = self.t_eval
+        j1 = int(np.searchsorted(te, t_hi, side="right"))
+        out = te[self.next_out:j1]
+        self.next_out = max(self.next_out, j1)
+        return out
+
+    def _count(self, nfev: int) -> None:
+        self.nfev += nfev
+        if self.nfev > self.options.max_rhs_evals:
+            raise _Stop(Status.STEP_BUDGET, f"{self.nfev} evaluations, at t = {self.t:.10g}")
+
+    def _integrate_chunks(self, rhs, events, atol, out_times=None) -> OdeSolution:
         """CVODE over the slide in chunks of tau (CVODE ties its smallest step to the
-        output time, so an open-ended output time is not an option)."""
+        output time, so an open-ended output time is not an option).  ``out_times``
+        (slide-local times): also stop at those (output events, index 5)."""
         opts = self.options
         y0 = np.zeros(3)
         tau0 = 0.0
         ts, ys, evs = [], [], []
         nfev = 0
+        terminal = (True, True, True, False, True)
+        direction = (-1, -1, -1, 0, 1)
         for _ in range(100000):
-            sol = integrate(rhs, y0, tau0, tau0 + _TAU_CHUNK, events=events,
-                            terminal=(True, True, True, False, True), direction=(-1, -1, -1, 0, 1),
-                            rtol=opts.rtol, atol=atol, method=opts.method,
-                            max_num_steps=opts.max_num_steps, save_steps=self.record)
+            save_steps = self.record and self.t_eval is None
+            if (out_times is not None and out_times.size) or save_steps:
+                sol = integrate_outputs(rhs, y0, tau0, tau0 + _TAU_CHUNK, out_index=1,
+                                        out_times=out_times, events=events, terminal=terminal,
+                                        direction=direction, rtol=opts.rtol, atol=atol,
+                                        method=opts.method, max_num_steps=opts.max_num_steps,
+                                        save_steps=save_steps)
+                n_found = sum(1 for ev in sol.events if ev[2] == len(terminal))
+                if out_times is not None:
+                    out_times = out_times[n_found:]
+            else:
+                sol = integrate(rhs, y0, tau0, tau0 + _TAU_CHUNK, events=events,
+                                terminal=terminal, direction=direction,
+                                rtol=opts.rtol, atol=atol, method=opts.method,
+                                max_num_steps=opts.max_num_steps)
             nfev += sol.nfev
+            self._count(sol.nfev)
             if not sol.success:
-                raise _Stop(Status.SOLVER_FAILED, f"CVODE in a slide at t = {self.t:g}: {sol.message}")
+                t_fail = self.t + float(sol.y[-1][1]) if np.all(np.isfinite(sol.y[-1])) else self.t
+                raise _Stop(Status.SOLVER_FAILED, f"CVODE in a slide at t = {t_fail:.10g}: "
+                                                  f"{sol.message}")
             ts.append(sol.t if not ts else sol.t[1:])
             ys.append(sol.y if not ys else sol.y[1:])
             evs.extend(sol.events)
@@ -291,8 +358,7 @@ class _PhaseEngine:
                 sol.events = evs
                 sol.nfev = nfev
                 return sol
-            tau0 = float(sol.t[-1])
-            y0 = sol.y[-1].copy()
+            y0 = sol.y[-1].copy()     # autonomous in tau: the next chunk restarts at 0
         raise _Stop(Status.SOLVER_FAILED, f"slide at t = {self.t:g} did not end")
 
     def _slide(self, t_end: float) -> Event:
@@ -327,11 +393,26 @@ class _PhaseEngine:
 
         t_scale = self.Dc / vs
         atol = np.array([opts.atol, opts.atol * t_scale, opts.atol * t_scale * max(1.0, abs(self.sigma))])
-        sol = self._integrate_chunks(rhs, events, atol)
         t0 = self.t
+        out_times = None
+        if self.record and self.t_eval is not None:
+            te = self.t_eval
+            j1 = int(np.searchsorted(te, t_stop, side="right"))
+            out_times = np.ascontiguousarray(te[self.next_out:j1] - t0)
+            out_times = out_times[out_times > 0.0]
+        sol = self._integrate_chunks(rhs, events, atol, out_times)
         x_lp0 = self.load_point(t0)
         if self.record:
-            ys = sol.y[1:]
+            if self.t_eval is None:
+                ys = sol.y[1:]
+            else:               # the output events, moved exactly onto the requested times
+                found = []
+                for (_tau, y, idx, _sign) in sol.events:
+                    if idx == 5:
+                        found.append(_onto_time(rhs, y, float(out_times[len(found)]), 1))
+                ys = np.array(found).reshape(-1, 3)
+                t_exact = self.t_eval[self.next_out:self.next_out + ys.shape[0]]
+                self.next_out += ys.shape[0]
             theta_arr = theta_s * np.exp(ys[:, 0])
             u_arr = self.Dc / theta_arr
             mu_arr = np.array([law(u, p)[0] for u in u_arr])
@@ -340,7 +421,7 @@ class _PhaseEngine:
             with np.errstate(divide="ignore", invalid="ignore"):
                 v_arr = (self.K * V - u_arr * w_arr) / d_arr
             v_arr[d_arr <= 0.0] = np.inf     # the slide ends where v diverges (D = 0)
-            t_arr = t0 + ys[:, 1]
+            t_arr = t0 + ys[:, 1] if self.t_eval is None else t_exact
             self.samples.add(t_arr, x_lp0 + V * ys[:, 1] - (self.mu_ref + mu_arr) / self.k0,
                              self.mu_ref + mu_arr, theta_arr, v_arr)
         for (tau, y, idx, _sign) in sol.events:
@@ -377,11 +458,18 @@ class _PhaseEngine:
 # a > 0: the regular rate-and-state ODE
 # ======================================================================================
 class _SmoothEngine:
-    """CVODE (BDF) on ``y = [ln v, ln(theta/Dc), x, int (sigma - mu_ref) dt, t]`` for a > 0,
-    in the slip-regularised variable s of :func:`rsf._kernels.rs_rhs`."""
+    """CVODE (BDF) on ``y = [ln v, ln(theta/Dc), x, int (sigma - mu_ref) dt, t
+    (, ln(theta2/Dc2))]`` for a > 0, in the slip-regularised variable s of
+    :func:`rsf._kernels.rs_rhs_dr`.
+
+    With ``t_eval`` the engine records samples only at those times: CVODE's root finder
+    stops at each of them (an output event in :func:`rsf._sundials.integrate_outputs`) and
+    returns its own interpolant there, which one Newton correction along the flow moves
+    exactly onto the requested time.
+    """
 
     def __init__(self, model: SpringSlider, protocol: Protocol, options: SolverOptions,
-                 record: bool, stop_at_steady: bool) -> None:
+                 record: bool, stop_at_steady: bool, t_eval: np.ndarray | None = None) -> None:
         self.model = model
         self.protocol = protocol
         self.options = options
@@ -393,9 +481,25 @@ class _SmoothEngine:
         self.law_fn = self.k.law_eval
         self.samples = _Samples()
         self.events: list[Event] = []
-        self.y = np.zeros(5)
+        self.second = model.second_state
+        self.n_vars = 5 if self.second is None else 6
+        self.y = np.zeros(self.n_vars)
         self.nfev = 0
         self.at_root = False       # the state sits on an event root (after a terminal event)
+        self.t_eval = t_eval
+        self.eta = model.eta_rad
+        state = model.state
+        self.state_code = float(state.code)
+        self.user_rate = state.func if state.code == USER else None
+        self.c_over_b = 0.0
+        if state.code == NAGATA:
+            b = state.b if state.b is not None else model.law.b
+            self.c_over_b = state.c / b
+        self.ln_v0 = math.log(model.law.v0) if isinstance(model.law, LogLaw) else 0.0
+        self.next_out = 0          # index of the next t_eval point to output
+        self.v_max = _runaway_bound(model, protocol, options)
+        # extrema of sigma closer than this (in ln theta) to the steady state are round-off
+        self.extremum_floor = 100.0 * max(options.rtol, options.atol)
 
     @property
     def t(self) -> float:
@@ -407,8 +511,19 @@ class _SmoothEngine:
         return float(self.y[3]) + self.mu_ref * float(self.y[4])
 
     def sigma_of(self, y: np.ndarray) -> float:
+        """The friction mu (the spring force is mu + eta_rad v)."""
         u = math.exp(-y[1])
-        return self.mu_ref + float(self.law_fn(u, self.p)[0]) + self.model.a * (y[0] + y[1])
+        out = self.mu_ref + float(self.law_fn(u, self.p)[0]) + self.model.a * (y[0] + y[1])
+        if self.second is not None:
+            out += self.second.b2 * (y[5] + self.ln_v0)
+        return out
+
+    def spring_of(self, y: np.ndarray) -> float:
+        """The spring force k0 (X - x) = mu + eta_rad v."""
+        out = self.sigma_of(y)
+        if self.eta > 0.0:
+            out += self.eta * math.exp(y[0])
+        return out
 
     def theta_of(self, y: np.ndarray) -> float:
         return self.model.Dc * math.exp(y[1])
@@ -425,7 +540,7 @@ class _SmoothEngine:
         if initial.theta is not None:
             theta = initial.theta
         elif V0 > 0.0:
-            theta = m.Dc / V0 * (1.0 + initial.perturbation)
+            theta = m.Dc / V0 * (1.0 + (initial.perturbation or 0.0))
         else:
             raise ValueError("initial.theta is required when the driving starts with V = 0")
         u = m.Dc / theta
@@ -435,17 +550,33 @@ class _SmoothEngine:
             lv = math.log(V0)
         else:
             lv = math.log(u) + (initial.sigma - self.mu_ref - float(self.law_fn(u, self.p)[0])) / m.a
-        self.y = np.array([lv, math.log(theta / m.Dc), 0.0, 0.0, 0.0])
-        self.y[2] = self.protocol.load_point(0.0) - self.sigma_of(self.y) / m.k0
+        self.y = np.zeros(self.n_vars)
+        self.y[:2] = [lv, math.log(theta / m.Dc)]
+        if self.second is not None:           # theta2 at steady state for the same ratio
+            self.y[5] = self.y[1]
+            if initial.sigma is not None:
+                raise ValueError("initial.sigma is not supported with a second state variable")
+        if initial.theta is None and (initial.perturbation or 0.0) == 0.0 and V0 > 0.0:
+            self.y[1] = -lv             # the exact steady state, free of the round-off of log
+            if self.second is not None:
+                self.y[5] = -lv
+        self.y[2] = self.protocol.load_point(0.0) - self.spring_of(self.y) / m.k0
         self.at_root = True        # v = V is a root of the extremum events
         if self.record:
-            self._record(self.y[None, :])
+            if self.t_eval is None:
+                self._record(self.y[None, :])
+            else:
+                self._output_here()
         self.emit("start")
 
     def set_state(self, lv: float, q: float) -> None:
         """Restart at (ln v, q) (used by the cycle extrapolation); x follows the spring."""
-        self.y = np.array([lv, q, 0.0, self.y[3], self.y[4]])
-        self.y[2] = self.protocol.load_point(self.t) - self.sigma_of(self.y) / self.model.k0
+        y = self.y.copy()
+        y[0], y[1] = lv, q
+        if self.second is not None:         # the second state keeps its distance to steady
+            y[5] += q - self.y[1]
+        self.y = y
+        self.y[2] = self.protocol.load_point(self.t) - self.spring_of(self.y) / self.model.k0
         self.at_root = True
         self.emit("restart")
 
@@ -455,8 +586,61 @@ class _SmoothEngine:
         mu = np.array([self.law_fn(ui, self.p)[0] for ui in u])
         with np.errstate(over="ignore"):
             v = np.exp(y[:, 0])
-        self.samples.add(y[:, 4], y[:, 2], self.mu_ref + mu + m.a * (y[:, 0] + y[:, 1]),
-                         m.Dc * np.exp(y[:, 1]), v)
+        sigma = self.mu_ref + mu + m.a * (y[:, 0] + y[:, 1])
+        if self.second is not None:
+            sigma = sigma + self.second.b2 * (y[:, 5] + self.ln_v0)
+        self.samples.add(y[:, 4], y[:, 2], sigma, m.Dc * np.exp(y[:, 1]), v)
+
+    def _output_here(self) -> None:
+        """Record the pending t_eval points that coincide with the current time."""
+        te = self.t_eval
+        t = self.t
+        while self.next_out < te.size and te[self.next_out] <= t:
+            if te[self.next_out] == t:
+                self._record(self.y[None, :])
+            self.next_out += 1
+
+    def _count(self, sol: OdeSolution) -> None:
+        self.nfev += sol.nfev
+        if self.nfev > self.options.max_rhs_evals:
+            raise _Stop(Status.STEP_BUDGET, f"{self.nfev} evaluations, at t = {self.t:.10g}")
+
+    def _steady_exactly(self, lnV: float) -> bool:
+        tol = 4.0 * np.finfo(float).eps * (1.0 + abs(lnV))
+        if self.second is not None and abs(self.y[5] + lnV) > tol:
+            return False
+        return abs(self.y[0] - lnV) <= tol and abs(self.y[1] + lnV) <= tol
+
+    def _advance_steady(self, V: float, t_stop: float, t_end: float) -> Event:
+        """Exact steady sliding up to t_stop: closed form, no integrator (and no event
+        function that is identically zero)."""
+        t0 = self.t
+        y0 = self.y.copy()
+        sigma_rel = self.sigma_of(y0) - self.mu_ref
+        if self.record:
+            if self.t_eval is None:
+                ts = np.array([t_stop])
+            else:
+                te = self.t_eval
+                j1 = int(np.searchsorted(te, t_stop, side="left"))
+                ts = te[self.next_out:j1]
+                self.next_out = max(self.next_out, j1)
+            if ts.size:
+                ys = np.repeat(y0[None, :], ts.size, axis=0)
+                ys[:, 2] = y0[2] + V * (ts - t0)
+                ys[:, 3] = y0[3] + sigma_rel * (ts - t0)
+                ys[:, 4] = ts
+                self._record(ys)
+        dt = t_stop - t0
+        self.y[2] = y0[2] + V * dt
+        self.y[3] = y0[3] + sigma_rel * dt
+        self.y[4] = t_stop
+        self.at_root = True
+        if self.record and self.t_eval is not None:
+            self._output_here()
+        if t_stop >= t_end:
+            return self.emit("end")
+        return self.emit("drive")
 
     def step(self, t_end: float, stop_on_min: bool) -> Event:
         m = self.model
@@ -466,82 +650,184 @@ class _SmoothEngine:
         t_stop = min(self.protocol.segment_end(t_now), t_end)
         lnV = math.log(V) if V > 0.0 else 0.0
         q_ss = -lnV
-        w_ss = float(self.law_fn(V, self.p)[1]) if V > 0.0 else 0.0
-        steady_on = 1.0 if (self.stop_at_steady and V > 0.0 and m.K - w_ss > 0.0) else 0.0
-        if steady_on and abs(self.y[0] - lnV) + abs(self.y[1] - q_ss) <= opts.cycle_rtol:
+        steady_on = 1.0 if (self.stop_at_steady and V > 0.0
+                            and stability_margin(m, V) < 0.0) else 0.0
+        slope = self.protocol.slope_at(t_now)
+        if slope != 0.0:
+            steady_on = 0.0
+        distance = abs(self.y[0] - lnV) + abs(self.y[1] - q_ss)
+        if self.second is not None:
+            distance += abs(self.y[5] - q_ss)
+        if steady_on and distance <= opts.cycle_rtol:
             return self.emit("steady")
+        if V > 0.0 and slope == 0.0 and self._steady_exactly(lnV):
+            if math.isfinite(t_stop):
+                return self._advance_steady(V, t_stop, t_end)
+            return self.emit("steady")       # on a fixed point for ever
         vs = V if V > 0.0 else max(math.exp(-self.y[1]), 1e-300)
         lvs = math.log(vs)
-        c = np.array([m.K, V, m.Dc, m.a, 0.0 if m.state_law == "aging" else 1.0, vs,
+        second = self.second
+        c = np.array([m.K, V, m.Dc, m.a, self.state_code, vs,
                       lnV - lvs if V > 0.0 else 0.0, lvs - lnV if V > 0.0 else 0.0,
-                      opts.cycle_rtol, steady_on, t_stop if math.isfinite(t_stop) else 1e300])
+                      opts.cycle_rtol, steady_on, t_stop if math.isfinite(t_stop) else 1e300,
+                      math.log(self.v_max) - lvs if math.isfinite(self.v_max) else 1e300,
+                      self.eta, self.c_over_b, second.b2 if second is not None else 0.0,
+                      m.Dc / second.Dc2 if second is not None else 0.0, self.ln_v0 - lvs,
+                      slope, t_now])
         k, p = self.k, self.p
+        user_rate = self.user_rate
+        Dc = m.Dc
+        output = self.record and self.t_eval is not None
+        if output:
+            j1 = int(np.searchsorted(self.t_eval, t_stop, side="left"))
+            grid = self.t_eval[self.next_out:j1]
+            grid = np.ascontiguousarray(grid[grid > t_now])
+        else:
+            grid = np.empty(0)
 
-        def rhs(s, y, yp):
-            k.rs_rhs(y, yp, p, c)
+        if user_rate is None:
+            def rhs(s, y, yp):
+                k.rs_rhs(y, yp, p, c)
+        else:
+            def rhs(s, y, yp):
+                # d ln(theta)/ds = (dtheta/dt / theta) dt/ds, with dt/ds = Dc f / vs
+                w = y[0]
+                f = 1.0 / (1.0 + math.exp(w)) if w <= 0.0 else math.exp(-w) / (1.0 + math.exp(-w))
+                theta = Dc * math.exp(y[1]) / vs
+                rate = user_rate(vs * math.exp(min(w, 700.0)), theta)
+                k.rs_rhs_dr(y, yp, p, c, rate / theta * Dc * f / vs)
 
         def events(s, y, e):
             k.rs_events(y, e, p, c)
+
+        terminal = (False, stop_on_min, True, True, True)
+        direction = (1, -1, -1, 1, 1)
 
         def to_local(y: np.ndarray) -> np.ndarray:      # [ln v, q, ...] -> [w, r, ...]
             out = y.copy()
             out[0] = y[0] - lvs
             out[1] = y[1] + lvs
+            if second is not None:
+                out[5] = y[5] + lvs
             return out
 
         def to_global(y: np.ndarray) -> np.ndarray:
             out = np.array(y, dtype=float, copy=True)
             out[..., 0] += lvs
             out[..., 1] -= lvs
+            if second is not None:
+                out[..., 5] -= lvs
             return out
 
         t_scale = m.Dc / vs
         atol = np.array([opts.atol, opts.atol, opts.atol * m.Dc,
                          opts.atol * t_scale * max(1.0, abs(self.sigma_of(self.y) - self.mu_ref)),
-                         opts.atol * t_scale])
+                         opts.atol * t_scale] + ([opts.atol] if second is not None else []))
         y_loc = to_local(self.y)
+        save_steps = self.record and not output
+
+        def failed(sol: OdeSolution) -> _Stop:
+            # keep the trajectory up to the failure and say where it happened
+            if sol.y.size and np.all(np.isfinite(sol.y[-1])):
+                self.y = to_global(sol.y[-1])
+            v_now = f"{math.exp(self.y[0]):.3g}" if self.y[0] < 700.0 else f"exp({self.y[0]:.4g})"
+            return _Stop(Status.SOLVER_FAILED, f"CVODE at t = {self.t:.10g} (v = {v_now}): "
+                                               f"{sol.message}")
+
+        def run(y_start, s_start, s_stop, with_events):
+            if (output and grid.size) or (save_steps and with_events):
+                return integrate_outputs(
+                    rhs, y_start, s_start, s_stop, out_index=4, out_times=grid,
+                    events=events if with_events else None,
+                    terminal=terminal if with_events else (),
+                    direction=direction if with_events else (), rtol=opts.rtol, atol=atol,
+                    method="BDF", max_num_steps=opts.max_num_steps, save_steps=save_steps)
+            if not with_events:
+                return integrate(rhs, y_start, s_start, s_stop, rtol=opts.rtol, atol=atol,
+                                 method="BDF", max_num_steps=opts.max_num_steps)
+            return integrate(rhs, y_start, s_start, s_stop, events=events, terminal=terminal,
+                             direction=direction, rtol=opts.rtol, atol=atol, method="BDF",
+                             max_num_steps=opts.max_num_steps, save_steps=save_steps)
+
+        def take_outputs(sol: OdeSolution, n_user: int) -> None:
+            nonlocal grid
+            used = 0
+            for (_s, y_ev, idx, _sign) in sol.events:
+                if idx == n_user:
+                    tj = float(grid[used])
+                    used += 1
+                    self._record(to_global(_onto_time(rhs, y_ev, tj))[None, :])
+            self.next_out += used
+            grid = grid[used:]
+
         if self.at_root:
             # step off an event root without events (CVODE rejects a root at the start)
-            sol = integrate(rhs, y_loc, 0.0, 1e-6, rtol=opts.rtol, atol=atol, method="BDF",
-                            max_num_steps=opts.max_num_steps)
+            sol = run(y_loc, 0.0, 1e-6, False)
+            self._count(sol)
             if not sol.success:
-                raise _Stop(Status.SOLVER_FAILED, f"CVODE at t = {self.t:g}: {sol.message}")
+                raise failed(sol)
+            take_outputs(sol, 0)
             y_loc = sol.y[-1].copy()
             self.at_root = False
         s0 = 0.0
         for _ in range(100000):
-            sol = integrate(rhs, y_loc, s0, s0 + _TAU_CHUNK, events=events,
-                            terminal=(False, stop_on_min, True, True), direction=(1, -1, -1, 1),
-                            rtol=opts.rtol, atol=atol, method="BDF",
-                            max_num_steps=opts.max_num_steps, save_steps=self.record)
-            self.nfev += sol.nfev
-            if not sol.success:
-                raise _Stop(Status.SOLVER_FAILED, f"CVODE at t = {self.t:g}: {sol.message}")
-            if self.record:
+            sol = run(y_loc, s0, s0 + _TAU_CHUNK, True)
+            if save_steps:
                 self._record(to_global(sol.y[1:]))
+            if not sol.success:
+                raise failed(sol)
+            self._count(sol)
             for (_s, y_ev, idx, _sign) in sol.events:
-                if idx == 0:
-                    self.emit("sigma_max", to_global(y_ev))
-                elif idx == 1 and not stop_on_min:
-                    self.emit("sigma_min", to_global(y_ev))
-            s0 = float(sol.t[-1])
-            y_loc = sol.y[-1].copy()
+                if idx == 0 or (idx == 1 and not stop_on_min):
+                    # a time series drops extrema at round-off distance from steady state;
+                    # a limit-cycle search keeps them all (tiny cycles near a Hopf point)
+                    if stop_on_min or abs(y_ev[1] - c[7]) > self.extremum_floor:
+                        self.emit("sigma_max" if idx == 0 else "sigma_min", to_global(y_ev))
+            take_outputs(sol, len(terminal))
+            y_loc = sol.y[-1].copy()       # the system is autonomous in s: restart at 0
             self.y = to_global(y_loc)
             if sol.terminal_event is not None:
                 break
         else:
-            raise _Stop(Status.SOLVER_FAILED, f"no progress at t = {self.t:g}")
+            raise _Stop(Status.SOLVER_FAILED, f"no progress at t = {self.t:.10g}")
         if sol.terminal_event == 1:
             self.at_root = True
             return self.emit("sigma_min")
         if sol.terminal_event == 2:
             return self.emit("steady")
+        if sol.terminal_event == 4:
+            self.emit("runaway")
+            raise _Stop(Status.RUNAWAY, f"v passed v_max = {self.v_max:.3g} at t = {self.t:.10g}")
         # terminal_event == 3: end of the window or a change of driving
         self.y[4] = t_stop
         self.at_root = True
+        if output:
+            self._output_here()
         if t_stop >= t_end:
             return self.emit("end")
         return self.emit("drive")
+
+
+def _onto_time(rhs, y: np.ndarray, t_target: float, index: int = 4) -> np.ndarray:
+    """Move a state found by CVODE's root finder (time ``y[index]`` within the root
+    tolerance of ``t_target``) exactly onto ``t_target`` with one Newton step along the
+    flow."""
+    yp = np.empty_like(y)
+    rhs(0.0, y, yp)
+    out = y.copy()
+    if yp[index] > 0.0:
+        out += (t_target - y[index]) / yp[index] * yp
+    out[index] = t_target
+    return out
+
+
+def _runaway_bound(model: SpringSlider, protocol: Protocol, options: SolverOptions) -> float:
+    """The velocity at which a run is declared a runaway (see ``SolverOptions.v_max``)."""
+    if options.v_max is not None:
+        return float(options.v_max)
+    if isinstance(model.law, LogLaw) and model.eta_rad == 0.0:
+        return _RUNAWAY_FACTOR * float(np.max(protocol.velocities))
+    return math.inf
 
 
 # ======================================================================================
@@ -561,7 +847,8 @@ def _protocol_from(V: float | None, protocol: Protocol | None) -> Protocol:
 
 def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
              protocol: Protocol | None = None, initial: InitialState | None = None,
-             options: SolverOptions | None = None, stop_at_steady: bool = False) -> Trajectory:
+             options: SolverOptions | None = None, stop_at_steady: bool = False,
+             t_eval: np.ndarray | None = None) -> Trajectory:
     r"""Integrate the spring-slider from ``t = 0`` to ``t_end`` and return the time series.
 
     Parameters
@@ -573,12 +860,19 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     t_end : float
         End time, > 0.
     protocol : Protocol, optional
-        Piecewise-constant driving (velocity steps, slide-hold-slide).
+        Driving history (velocity steps, slide-hold-slide, a sampled V(t)).
     initial : InitialState, optional
-        Default: the steady state at the first velocity, theta perturbed by 1e-3.
+        Default: the exact steady state at the first velocity for a protocol that changes
+        the velocity; for constant driving the steady state with theta perturbed by 1e-3.
     options : SolverOptions, optional
     stop_at_steady : bool
         End the run as soon as a stable steady slide is reached (status ``STEADY``).
+    t_eval : array_like, optional
+        Times (sorted, strictly increasing, in ``[0, t_end]``) at which to return the
+        samples, like ``scipy.integrate.solve_ivp``: for :math:`a > 0` CVODE stops at each
+        of them with its own interpolant (no interpolation of the output).  Events keep
+        their exact times.  Default: every internal step of the integrator.  A run that
+        stops early (runaway, failure) returns the samples up to there.
 
     Returns
     -------
@@ -591,9 +885,18 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     t_end = positive("t_end", t_end)
     protocol = _protocol_from(V, protocol)
     initial = initial or InitialState()
+    initial = initial.resolved(InitialState.DEFAULT_PERTURBATION if protocol.is_constant else 0.0)
     options = options or SolverOptions()
-    engine_cls = _PhaseEngine if model.a == 0.0 else _SmoothEngine
-    engine = engine_cls(model, protocol, options, record=True, stop_at_steady=stop_at_steady)
+    t_eval = _check_t_eval(t_eval, t_end)
+    if model.a == 0.0 and protocol.is_linear:
+        raise ValueError("a sampled (linearly interpolated) load history needs a direct "
+                         "effect a > 0; for a = 0 use piecewise-constant steps")
+    if model.a == 0.0:
+        engine = _PhaseEngine(model, protocol, options, record=True,
+                              stop_at_steady=stop_at_steady, t_eval=t_eval)
+    else:
+        engine = _SmoothEngine(model, protocol, options, record=True,
+                               stop_at_steady=stop_at_steady, t_eval=t_eval)
     engine.start(initial)
     status = Status.TIME_LIMIT
     detail = ""
@@ -623,6 +926,21 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
                       status=status, message=message, params=model.describe())
 
 
+def _check_t_eval(t_eval, t_end: float) -> np.ndarray | None:
+    if t_eval is None:
+        return None
+    arr = np.atleast_1d(np.asarray(t_eval, dtype=float)).ravel()
+    if arr.size == 0:
+        raise ValueError("t_eval must hold at least one time")
+    if not np.all(np.isfinite(arr)) or np.any(np.diff(arr) <= 0.0):
+        raise ValueError("t_eval must be finite and strictly increasing")
+    if arr[0] < 0.0 or arr[-1] > t_end:
+        raise ValueError(f"t_eval must lie in [0, t_end = {t_end!r}], got [{arr[0]!r}, {arr[-1]!r}]")
+    arr = arr.copy()
+    arr.setflags(write=False)
+    return arr
+
+
 @dataclass
 class _Cycle:
     sigma_max: float
@@ -635,8 +953,12 @@ class _Cycle:
 
 
 def _relative_change(a: _Cycle, b: _Cycle) -> float:
+    """Largest relative change of sigma_max, sigma_min, the period and the amplitude
+    sigma_max - sigma_min (the amplitude: so that a slowly decaying oscillation of small
+    amplitude is not taken for a converged cycle)."""
     out = 0.0
-    for x, y in ((a.sigma_max, b.sigma_max), (a.sigma_min, b.sigma_min), (a.period, b.period)):
+    for x, y in ((a.sigma_max, b.sigma_max), (a.sigma_min, b.sigma_min), (a.period, b.period),
+                 (a.sigma_max - a.sigma_min, b.sigma_max - b.sigma_min)):
         scale = max(abs(x), abs(y), 1e-300)
         out = max(out, abs(x - y) / scale)
     return out
@@ -665,7 +987,10 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     V = positive("V", V)
     options = options or SolverOptions()
-    initial = initial or InitialState()
+    if model.second_state is not None and options.accelerate:
+        # the cycle map has two dimensions: no one-variable extrapolation
+        options = replace(options, accelerate=False)
+    initial = (initial or InitialState()).resolved(InitialState.DEFAULT_PERTURBATION)
     started = time.perf_counter()
     protocol = Protocol.constant(V)
     smooth = model.a > 0.0

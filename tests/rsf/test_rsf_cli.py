@@ -162,3 +162,64 @@ def test_run_slide_hold_slide_and_steps_match_the_api(tmp_path):
     # the hold (t in [5, 7]): with the load point at rest the stress cannot rise
     hold = series[(series.t > 5.0 + 1e-9) & (series.t < 7.0 - 1e-9)]
     assert len(hold) > 1 and np.all(np.diff(hold.sigma) <= 1e-12)
+
+
+def test_run_t_eval_and_runaway_on_the_command_line(tmp_path, capsys):
+    out = tmp_path / "run.csv"
+    log = ["--law", "log", "--b", "0.01", "--law-a", "0.005", "--a", "0.005", "--v0", "1",
+           "--Dc", "10", "--mu0", "0.6"]
+    assert main(["run", "--k0", "0.01", *log, "--steps", "1:10,10", "--t-end", "60",
+                 "--t-eval-n", "61", "--out", str(out)]) == 0
+    series = pd.read_csv(out)
+    model = rsf.standard_rs(mu0=0.6, a=0.005, b=0.01, Dc=10.0, k0=0.01, v0=1.0)
+    api = rsf.simulate(model, t_end=60.0, protocol=rsf.Protocol.velocity_steps([1.0, 10.0], [10.0]),
+                       t_eval=np.linspace(0.0, 60.0, 61))
+    assert np.array_equal(series.t.to_numpy(), np.linspace(0.0, 60.0, 61))
+    assert np.abs(series.sigma.to_numpy() - api.sigma).max() < 1e-14
+    assert main(["run", "--k0", "0.01", *log, "--steps", "1:10,10", "--t-end", "60",
+                 "--t-eval", "0,1,2.5", "--out", str(out)]) == 0
+    assert list(pd.read_csv(out).t) == [0.0, 1.0, 2.5]
+    # the runaway (k0 = 0.8 k_c): exit status 3, a message with the time
+    assert main(["run", "--k0", "0.0004", *log, "--steps", "1:10,10", "--t-end", "60",
+                 "--out", str(out)]) == 3
+    assert "runaway" in capsys.readouterr().err
+    assert main(["run", "--k0", "0.01", *log, "--steps", "1:10,10", "--t-end", "60",
+                 "--t-eval", "0,70", "--out", str(out)]) == 2
+    assert main(["run", "--k0", "0.01", *log, "--V", "1", "--t-end", "60",
+                 "--t-eval-n", "1", "--out", str(out)]) == 2
+
+
+def test_run_history_state_laws_and_damping_on_the_command_line(tmp_path):
+    hist = tmp_path / "history.csv"
+    ts = np.linspace(0.0, 30.0, 31)
+    pd.DataFrame({"t": ts, "V": 1.0 + 0.5 * np.sin(ts) ** 2}).to_csv(hist, index=False)
+    out = tmp_path / "run.csv"
+    log = ["--law", "log", "--b", "0.01", "--law-a", "0.005", "--a", "0.005", "--v0", "1",
+           "--Dc", "10", "--mu0", "0.6"]
+    extra = ["--state-law", "nagata", "--nagata-c", "1.5", "--b2", "0.003", "--Dc2", "30"]
+    # Nagata with a second state is refused by the model (exit status 2)
+    assert main(["run", "--k0", "0.01", *log, *extra, "--history", str(hist),
+                 "--t-end", "40", "--out", str(out)]) == 2
+    assert main(["run", "--k0", "0.01", *log, "--state-law", "prz", "--b2", "0.003", "--Dc2", "30",
+                 "--eta-rad", "0.001", "--history", str(hist), "--t-end", "40", "--t-eval-n", "41",
+                 "--out", str(out)]) == 0
+    series = pd.read_csv(out)
+    model = rsf.standard_rs(mu0=0.6, a=0.005, b=0.01, Dc=10.0, k0=0.01, v0=1.0, state_law="prz",
+                            second_state=rsf.SecondState(0.003, 30.0), eta_rad=0.001)
+    api = rsf.simulate(model, protocol=rsf.Protocol.sampled(ts, 1.0 + 0.5 * np.sin(ts) ** 2),
+                       t_end=40.0, t_eval=np.linspace(0.0, 40.0, 41))
+    assert np.abs(series.sigma.to_numpy() - api.sigma).max() < 1e-14
+    assert main(["run", "--k0", "0.01", *log, "--b2", "0.003", "--V", "1", "--t-end", "4",
+                 "--out", str(out)]) == 2                                  # --Dc2 missing
+    assert main(["run", "--k0", "0.01", *log, "--history", str(tmp_path / "nope.csv"),
+                 "--t-end", "4", "--out", str(out)]) == 2
+
+
+def test_critical_and_sweep_with_radiation_damping(tmp_path):
+    out = tmp_path / "vc.csv"
+    log = ["--law", "log", "--b", "0.01", "--law-a", "0.005", "--a", "0.005", "--v0", "1",
+           "--Dc", "10", "--eta-rad", "1e-4"]
+    assert main(["critical", "--k0", "0.0004", *log, "--out", str(out)]) == 0
+    assert pd.read_csv(out).Vc[0] == pytest.approx(10.0, rel=1e-13)     # (b - a - k0 Dc)/eta
+    assert main(["sweep", "--k0", "0.0004", *log, "--V", "5,20", "--out", str(out)]) == 0
+    assert list(pd.read_csv(out).regime) == ["stick-slip", "steady"]

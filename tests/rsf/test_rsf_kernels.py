@@ -39,12 +39,16 @@ def test_compiled_kernels_match_plain_python(k0, V):
     K.slide_rhs(y, ya, p, c)
     PLAIN["slide_rhs"](y, yb, p, c)
     np.testing.assert_allclose(ya, yb, rtol=1e-14)
-    y = np.array([0.4, -0.2, 0.0, 0.0, 0.0])
-    c = np.array([m.K, V, m.Dc, 1e-3, 0.0, V, 0.0, 0.0, 1e-8, 0.0, 1e9])
-    ya, yb = np.zeros(5), np.zeros(5)
-    K.rs_rhs(y, ya, p, c)
-    PLAIN["rs_rhs"](y, yb, p, c)
-    np.testing.assert_allclose(ya, yb, rtol=1e-14)
+    # every state law (aging, slip, PRZ, Nagata), radiation damping and a second state
+    for code, eta, cb, b2 in [(0, 0, 0, 0), (1, 0, 0, 0), (2, 0, 0, 0), (3, 0, 0.5, 0),
+                              (0, 0.1, 0, 0), (3, 0.1, 0.5, 0), (1, 0, 0, 0.01), (2, 0.1, 0, 0.01)]:
+        y = np.array([0.4, -0.2, 0.0, 0.0, 0.0, 0.3])
+        c = np.array([m.K, V, m.Dc, 1e-3, code, V, 0.0, 0.0, 1e-8, 0.0, 1e9, 1e300,
+                      eta, cb, b2, 0.7, 0.1, 0.02 * (code == 1), 0.5])
+        ya, yb = np.zeros(6), np.zeros(6)
+        K.rs_rhs(y, ya, p, c)
+        PLAIN["rs_rhs"](y, yb, p, c)
+        np.testing.assert_allclose(ya, yb, rtol=1e-14)
 
 
 def _phi(m, theta):

@@ -98,3 +98,85 @@ def test_grid_direct_effect(a, law):
 @pytest.mark.parametrize("k0", [1e-3, 1e-2, 0.1])
 def test_grid_eq4_law(k0):
     _check(rsf.SpringSlider(rsf.ViscoelasticLaw(), k0=k0))
+
+
+# ---------------------------------------------------------------------------------------
+# the options of issue 17: radiation damping, state laws, runaway, t_eval, load histories
+# ---------------------------------------------------------------------------------------
+REL_DAMPED = [1e-3, 0.1, 0.5, 0.9, 1.1, 10.0, 1e3]
+
+
+@pytest.mark.parametrize("state_law", ["aging", "slip", "prz", rsf.NagataLaw(c=1.0)])
+def test_radiation_damping_over_velocities(state_law):
+    """Log law below its critical stiffness: with damping every run converges, to cycles
+    below Vc and to steady sliding above it, as the stability analysis says."""
+    model = rsf.standard_rs(mu0=0.6, a=0.005, b=0.01, Dc=10.0, k0=0.0004, v0=1.0,
+                            eta_rad=1e-4, state_law=state_law)
+    _check(model, rel=REL_DAMPED)
+
+
+def test_radiation_damping_on_the_paper_law():
+    model = rsf.SpringSlider(rsf.HyperbolicLaw(mu_inf=0.9), k0=0.3, a=1e-3, eta_rad=1e-2)
+    _check(model, rel=[0.3, 0.9, 1.1, 10.0])
+
+
+@pytest.mark.parametrize("state_law", ["aging", "slip", "prz", rsf.NagataLaw(c=2.0)])
+def test_velocity_steps_never_hang(state_law):
+    """Below, near and above k_c, steps up by 1e1 .. 1e3: each run ends (reached the end or
+    ran away) within seconds, with a finite trajectory and the runaway time in its
+    message."""
+    import time
+
+    for k_over_kc in (0.5, 0.9, 1.1, 3.0):
+        for v1 in (10.0, 1e3):
+            model = rsf.standard_rs(mu0=0.6, a=0.005, b=0.01, Dc=10.0, k0=k_over_kc * 5e-4,
+                                    v0=1.0, state_law=state_law)
+            started = time.perf_counter()
+            tr = rsf.simulate(model, protocol=rsf.Protocol.velocity_steps([1.0, v1, 1.0], [10, 20]),
+                              t_end=100.0)
+            assert time.perf_counter() - started < 5.0
+            assert tr.status in (rsf.Status.TIME_LIMIT, rsf.Status.RUNAWAY), tr.message
+            assert np.all(np.isfinite(tr.sigma)) and np.all(np.isfinite(tr.v))
+            if tr.status == rsf.Status.RUNAWAY:
+                assert f"t = {tr.t[-1]:.10g}" in tr.message and tr.v[-1] >= 1e3 * v1 * (1 - 1e-9)
+
+
+def test_t_eval_on_random_grids(rng):
+    """Random output grids (including 0, segment boundaries and t_end): every requested
+    time comes back exactly, once, with finite values; the events are those of the run
+    without t_eval."""
+    model = rsf.standard_rs(mu0=0.6, a=0.005, b=0.01, Dc=10.0, k0=0.002, v0=1.0, state_law="slip")
+    proto = rsf.Protocol.velocity_steps([1.0, 3.0, 0.0, 1.0], [10.0, 20.0, 15.0])
+    full = rsf.simulate(model, protocol=proto, t_end=80.0)
+    for n in (1, 7, 500):
+        te = np.unique(np.concatenate([rng.uniform(0.0, 80.0, n), [0.0, 10.0, 30.0, 45.0, 80.0]]))
+        tr = rsf.simulate(model, protocol=proto, t_end=80.0, t_eval=te)
+        assert tr.success and np.array_equal(tr.t, te)
+        assert np.all(np.isfinite(tr.sigma)) and np.all(np.isfinite(tr.theta))
+        assert [e.kind for e in tr.events] == [e.kind for e in full.events]
+        assert np.allclose([e.t for e in tr.events], [e.t for e in full.events], rtol=0, atol=1e-9)
+        # the samples at the changes of driving are the states of the 'drive' events
+        for e in tr.events:
+            if e.kind == "drive":
+                i = int(np.searchsorted(te, e.t))
+                assert te[i] == e.t and abs(tr.sigma[i] - e.sigma) < 1e-12
+
+
+def test_sampled_histories_stay_finite(rng):
+    model = rsf.standard_rs(mu0=0.6, a=0.005, b=0.01, Dc=10.0, k0=0.002, v0=1.0)
+    for _ in range(3):
+        ts = np.concatenate([[0.0], np.cumsum(rng.uniform(0.5, 5.0, 20))])
+        vs = np.exp(rng.uniform(-2.0, 2.0, ts.size))
+        tr = rsf.simulate(model, protocol=rsf.Protocol.sampled(ts, vs), t_end=float(ts[-1]) + 5.0)
+        assert tr.success, tr.message
+        assert np.all(np.isfinite(tr.sigma)) and np.all(tr.v > 0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("eta", [1e-6, 1e-4, 1e-2])
+@pytest.mark.parametrize("k_over_kc", [0.2, 0.8, 0.95])
+@pytest.mark.parametrize("state_law", ["aging", "slip"])
+def test_grid_radiation_damping(eta, k_over_kc, state_law):
+    model = rsf.standard_rs(mu0=0.6, a=0.005, b=0.01, Dc=10.0, k0=k_over_kc * 5e-4, v0=1.0,
+                            eta_rad=eta, state_law=state_law)
+    _check(model, rel=REL_DAMPED)
