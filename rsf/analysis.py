@@ -1,7 +1,7 @@
 r"""Linear stability of steady sliding, and the scaling of the stick-slip amplitude near the
 bifurcation.
 
-Stability (``docs/rsf.md`` has the derivation).  Linearising the spring-slider about
+Stability (``docs/reference/rsf.md`` has the derivation).  Linearising the spring-slider about
 steady sliding at :math:`V` (:math:`\theta = D_c/V`) gives, for the aging law (Eq. 8),
 any direct effect :math:`a \ge 0` and the slip law alike, a trace proportional to
 :math:`W(V) - k_0 D_c` with :math:`W(V) = -V\,\mathrm{d}\mu_{ss}/\mathrm{d}V`: steady sliding
