@@ -64,6 +64,14 @@ intersphinx_mapping = {
 if not os.environ.get("FRICTIONKIT_DOCS_INTERSPHINX"):
     intersphinx_mapping = {}
 
+# autosummary's one-line summaries end at the first ". " that is not a known abbreviation:
+# add the paper's ("Eqs. (1)-(2)", "Fig. 7", "Sec. V") so that the sentence is not cut there.
+import sphinx.ext.autosummary as _autosummary  # noqa: E402
+
+_autosummary.WELL_KNOWN_ABBREVIATIONS = (*_autosummary.WELL_KNOWN_ABBREVIATIONS, "Eq.", "Eqs.", "Fig.", "Figs.", "Sec.",
+                                         " Eq.", " Eqs.", " Fig.", " Figs.", " Sec.", "(Eq.", "(Eqs.",
+                                         "(Fig.", "(Sec.", " cf.", "(cf.", " vs.")
+
 # -- Examples (sphinx-gallery) -----------------------------------------------------------
 sphinx_gallery_conf = {
     "examples_dirs": "examples",
