@@ -68,3 +68,19 @@ def test_every_docs_path_mentioned_in_the_code_exists():
             if not (ROOT / mention).exists():
                 missing.append(f"{source.relative_to(ROOT)}: {mention}")
     assert not missing, missing
+
+
+def _python_blocks(page: Path) -> list[str]:
+    return re.findall(r"^```python\n(.*?)^```", page.read_text(), re.M | re.S)
+
+
+@pytest.mark.parametrize("page", [pytest.param("micro", marks=pytest.mark.slow), "rsf"])
+def test_user_guide_code_runs_as_written(page, tmp_path, monkeypatch):
+    # the compare guide's blocks run a report and use the reader's own tables: its tasks run
+    # as the gallery examples instead (tests/compare/test_compare_examples.py)
+    monkeypatch.chdir(tmp_path)
+    blocks = _python_blocks(DOCS / "guide" / f"{page}.md")
+    assert len(blocks) >= 4
+    namespace: dict = {}
+    for i, block in enumerate(blocks):
+        exec(compile(block, f"docs/guide/{page}.md, block {i + 1}", "exec"), namespace)
