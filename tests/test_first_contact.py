@@ -80,3 +80,35 @@ def test_summary_lists_every_unconverged_point():
     assert text.startswith("## Warnings")
     assert "2 Fokker-Planck points" in text and "k0 = 0.1, V = 0.5" in text and "k0 = 0.3, V = 0.1" in text
     assert "V = 0.2" not in text
+
+
+class _Interrupted(BaseException):
+    pass
+
+
+def _interrupting_writer(frame_or_path, *args, **kwargs):
+    raise _Interrupted  # as if Ctrl-C arrived in the middle of writing
+
+
+def test_writes_are_atomic_an_interrupted_write_leaves_the_old_file(tmp_path, monkeypatch):
+    from compare.output import ReportFolder
+    from micro.cli import _write_csv
+    from rsf.cli import _write
+
+    frame = pd.DataFrame({"a": [1.0, 2.0]})
+    for write in (lambda out: _write_csv(frame, out), lambda out: _write(frame, str(out))):
+        out = tmp_path / f"{id(write)}.csv"
+        out.write_text("old\n")
+        with monkeypatch.context() as m:
+            m.setattr(pd.DataFrame, "to_csv", _interrupting_writer)
+            with pytest.raises(_Interrupted):
+                write(out)
+        assert out.read_text() == "old\n"
+        write(out)
+        assert pd.read_csv(out).a.tolist() == [1.0, 2.0]
+    folder = ReportFolder(tmp_path / "report")
+    folder.write("t.csv", lambda p: p.write_text("old\n"))
+    with pytest.raises(_Interrupted):
+        folder.write("t.csv", _interrupting_writer)
+    assert (tmp_path / "report" / "t.csv").read_text() == "old\n"
+    assert not [p for p in tmp_path.rglob("*") if p.name.endswith(".tmp") or p.name.startswith(".t.csv")]
