@@ -112,3 +112,15 @@ def test_writes_are_atomic_an_interrupted_write_leaves_the_old_file(tmp_path, mo
         folder.write("t.csv", _interrupting_writer)
     assert (tmp_path / "report" / "t.csv").read_text() == "old\n"
     assert not [p for p in tmp_path.rglob("*") if p.name.endswith(".tmp") or p.name.startswith(".t.csv")]
+
+
+def test_micro_sweep_and_critical_report_each_point_as_it_finishes(tmp_path, capsys):
+    # issue 18 item 6: micro's long commands were silent for minutes
+    from micro.cli import main
+
+    assert main(["sweep", "--k0", "0.1", "--V", "2,5", "--out", str(tmp_path / "s.csv")]) == 0
+    lines = capsys.readouterr().err.splitlines()
+    assert re.match(r"^\[1/2, \d+ s\] V=2: steady, sigma_max=0\.89", lines[0]) and lines[1].startswith("[2/2, ")
+    assert main(["critical", "--k0", "0.3,0.1", "--out", str(tmp_path / "c.csv"), "-v"]) == 0
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("[")]
+    assert [line.split("]")[0] for line in lines][0].startswith("[1/2") and "k0=0.1: Vc=0.727504" in lines[1]
