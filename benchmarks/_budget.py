@@ -14,7 +14,7 @@ import micro
 K0 = (0.3, 0.1, 0.01, 0.001, 0.0001)
 #: RS critical velocity of Eq. (12) with the paper's A = 0.007, B = 0.078, D_c = 0.06
 #: (compare/ reports 0.2029, 1.005, 11.51, 116.5, 1167); micro's lies within ~25 % where
-#: measured (docs/micro_numerics.md §4): velocities are placed around it.
+#: measured (docs/reference/micro_numerics.md §4): velocities are placed around it.
 VC_RS = {0.3: 0.2029, 0.1: 1.005, 0.01: 11.51, 0.001: 116.5, 0.0001: 1167.0}
 
 

@@ -6,7 +6,7 @@ Eq. (12) with the paper's A, B and D_c, which lies above the micro V^c where tha
 known) for a sequence of bins, each run capped at a wall-time budget.
 
 Reference: the exact stationary stress of the renewal chain, ``micro.steady_sliding``
-(error ~1e-12, docs/micro_renewal.md), for every k0; the error of each bin is a number,
+(error ~1e-12, docs/reference/micro_renewal.md), for every k0; the error of each bin is a number,
 and ``order`` is the least-squares slope of log |error| on log eps.  The columns
 ``extrapolation`` and ``extrapolation_order`` keep the eps -> 0 extrapolation sigma_0 of
 sigma(eps) = sigma_0 + c eps^p that served as reference before the chain existed: at

@@ -23,7 +23,7 @@ Writes docs/data/micro_fig{3,4,7}.csv and docs/figures/micro_fig{3,4,6,7}.png.
     python benchmarks/micro_paper_figures.py --figs 4,6 --replot
 
 A converged cycle flagged as possibly the grid's oscillation (stress drop below
-10 k0 eps, see docs/micro_numerics.md) is drawn as a cross at its mean stress.
+10 k0 eps, see docs/reference/micro_numerics.md) is drawn as a cross at its mean stress.
 """
 from __future__ import annotations
 

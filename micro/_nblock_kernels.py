@@ -3,7 +3,7 @@
 Nothing here validates its input: :mod:`micro.nblock` builds every array and checks every
 parameter before calling :func:`run_events`.
 
-Lazy representation (derived in ``docs/micro_nblock.md``)
+Lazy representation (derived in ``docs/reference/micro_nblock.md``)
 ---------------------------------------------------------
 With :math:`s_i = u_i + h_i` and the global exponentially weighted mean :math:`m(t)` of
 :math:`\\bar h` (:math:`\\dot m = \\gamma(\\bar h - m)`, :math:`\\gamma = k_2/\\eta_u`), every block

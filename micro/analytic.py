@@ -4,8 +4,8 @@
 * The V -> infinity limit for any g (Eq. (6) is its deterministic case), with the first
   1/V correction, and the V -> 0 limit of steady sliding (k0 > k2) for any g (Eq. (5)).
 
-The derivations are in ``docs/micro_model.md`` (and, for the corrections, in
-``docs/micro_nblock.md``).  Both solvers are tested against these.
+The derivations are in ``docs/reference/micro_model.md`` (and, for the corrections, in
+``docs/reference/micro_nblock.md``).  Both solvers are tested against these.
 """
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 Defaults are the paper's Fig. 4 parameters (k1 = 0.1, k2 = 0.9, zbar = 0.1, exponential
 pinning distances with cutoff 10, eta_u = 1, f_th = 1).  The default bin eps is
 kappa*zbar/50 (2e-3 for these parameters); its error on a stationary stress is about
-1e-4 (second order in eps, see docs/micro_numerics.md), coarser bins run much faster.
+1e-4 (second order in eps, see docs/reference/micro_numerics.md), coarser bins run much faster.
 """
 from __future__ import annotations
 

@@ -14,7 +14,7 @@ with z drawn from :math:`g(z)`, and :math:`u_i` does not change. Between jumps t
 :math:`u_i` relax in closed form (Eq. (B3)).
 
 The simulation is event driven and exact up to round-off: there is no time step. See
-``docs/micro_nblock.md`` for the derivations (jump and redistribution increments, the
+``docs/reference/micro_nblock.md`` for the derivations (jump and redistribution increments, the
 O(log N) lazy representation, the analytic limits used by the tests).
 
 This module shares nothing with the Fokker-Planck solver but :mod:`micro.params`.
@@ -712,7 +712,7 @@ def stick_slip_extrema_nblock(
 
 
 # ---------------------------------------------------------------------------------------
-# analytic results the tests compare with (derived in docs/micro_nblock.md)
+# analytic results the tests compare with (derived in docs/reference/micro_nblock.md)
 # ---------------------------------------------------------------------------------------
 
 
@@ -730,7 +730,7 @@ def sigma_deterministic_steady_finite_n(model: Model, velocity: float, n_blocks:
                     \frac{q\,(1 - N q^{N-1} + (N-1) q^N)}{(1-q)(1-q^N)}, \\
         \langle\sigma\rangle &= \sigma_b - \frac{k_0 \bar z}{2N},
 
-    which tends to Eq. (4) as :math:`N \to \infty`. Derived in ``docs/micro_nblock.md``.
+    which tends to Eq. (4) as :math:`N \to \infty`. Derived in ``docs/reference/micro_nblock.md``.
     """
     _check_model(model)
     v = _check_float("velocity", velocity, low=0.0, strict=True)

@@ -1,7 +1,7 @@
 r"""Steady sliding and its stability, solved directly: the jump-to-jump renewal chain.
 
 In steady sliding the mean position moves at the drive velocity V, so every block is an
-independent renewal process driven at V (the derivation is in ``docs/micro_renewal.md``).
+independent renewal process driven at V (the derivation is in ``docs/reference/micro_renewal.md``).
 Between jumps a block's lag behind the mean grows at rate V and its k2-spring stretch
 ``e`` relaxes towards ``V tau`` (``tau = eta_u / k2 = 1/gamma``); it jumps when its
 margin reaches 0, and a jump lowers both by z ~ g.  Just before a jump the margin is 0,

@@ -138,7 +138,7 @@ class Stationary:
     ``shocks_per_cycle`` counts the global shocks (cascades of more than 8 bins) per
     cycle of a stick-slip result.
     ``converged`` says whether the stopping test was met; ``message`` says why the run
-    ended.  ``mass_error`` (|total probability - 1|) and ``min_mass`` (the most negative
+    ended.  ``mass_error`` (``abs(total probability - 1)``) and ``min_mass`` (the most negative
     cell mass ever seen, 0 if none) are the solver's own checks of the density.
     ``records`` holds the stress time series when asked for.
     """
@@ -221,7 +221,7 @@ def _initial_grid(model: Model, settings: GridSettings, V: float, initial) -> Gr
 
 #: Peak-to-peak discretisation jitter of the stress, in units of k0 * eps (measured:
 #: the standard deviation of the stress in steady sliding is about 0.15 k0 eps for
-#: eps from 4e-3 to 1.6e-2 and k0 from 0.1 to 0.3, see docs/micro_numerics.md).
+#: eps from 4e-3 to 1.6e-2 and k0 from 0.1 to 0.3, see docs/reference/micro_numerics.md).
 JITTER = 1.0
 
 
@@ -243,7 +243,7 @@ def _time_scales(model: Model, V: float) -> tuple[float, float, float]:
 #: below GRID_CYCLE_EPS * eps, may be an oscillation of the discretisation: seen with drops
 #: of 2.2-5.6 k0 eps at large V (k0 = 1e-3, V = 175; k0 = 0.01, V = 1000), amplitudes
 #: falling like eps^2, and near V^c of up to 1.6 eps (eps = 0.016) and 1.9 eps (0.008)
-#: at both k0 = 0.1 and 0.3, amplitudes ~ eps (docs/micro_results.md, micro_numerics.md §5).
+#: at both k0 = 0.1 and 0.3, amplitudes ~ eps (docs/validation/micro_results.md, docs/reference/micro_numerics.md §5).
 MARGINAL_CYCLE = 10.0
 GRID_CYCLE_EPS = 2.0
 
@@ -425,7 +425,7 @@ def stationary(
         t_now = grid.t
         # (the last chunk may overshoot t_max; stopping exactly at t_max shortened the
         # runs of the phase diagram's coarse-bin bisection and flipped their labels,
-        # see docs/micro_results.md)
+        # see docs/validation/micro_results.md)
         r, s, code = grid.advance(V, t_now + chunk, record_dsigma=resolution, record_dt=span / 20.0)
         rec = rec.extend(Records.from_array(r))
         if len(s):
@@ -611,7 +611,7 @@ def _bisection_label(res: Stationary) -> str:
 
 #: With ``refine``, an oscillation is taken for the grid's when its amplitude at eps / 2
 #: is below this fraction of its amplitude at eps.  Measured stepping down from steady
-#: sliding (docs/micro_numerics.md, section 5): physical cycles keep 0.77-1.0 of their
+#: sliding (docs/reference/micro_numerics.md, section 5): physical cycles keep 0.77-1.0 of their
 #: amplitude when eps halves (k0 = 0.1, V <= 0.7; k0 = 0.3, V <= 0.15), the grid's keep
 #: 0.31-0.65 (k0 = 0.1, V >= 0.75; k0 = 0.3, V >= 0.2), where the N-block has no cycle.
 REFINE_RATIO = 0.7
@@ -652,7 +652,7 @@ def critical_velocity(
 
     ``method="renewal"`` (the default) solves it directly: V^c is the root of
     ``b(V) = 1``, the branching ratio of steady sliding from the renewal chain
-    (:func:`micro.steady_sliding`; derivation in docs/micro_renewal.md), to ~1e-10
+    (:func:`micro.steady_sliding`; derivation in docs/reference/micro_renewal.md), to ~1e-10
     relative in a fraction of a second.  ``V_min`` and ``V_max`` (default 1e7 here, 1e3
     for the bisection) bound the search; the other options belong to ``method="fp"``.
     ``k0 >= k2``: Vc = 0 at once (steady sliding is stable at every V).  ``V_low`` and
@@ -681,7 +681,7 @@ def critical_velocity(
     keeps at least ``REFINE_RATIO`` (0.7) of its amplitude: a physical cycle converges
     in eps, the grid's shrinks with it.  A check costs 7-12 runs at eps, and near V^c
     most runs need one.  Measured against the N-block's V^c (0.70-0.75 at k0 = 0.1,
-    0.19-0.21 at k0 = 0.3): 0.73 and 0.186 at eps = 0.016 (docs/micro_numerics.md,
+    0.19-0.21 at k0 = 0.3): 0.73 and 0.186 at eps = 0.016 (docs/reference/micro_numerics.md,
     section 5).  Without ``refine`` a cycle counts as stick-slip only if it has global
     shocks or a stress drop of at least ``min(MARGINAL_CYCLE * k0 * eps, GRID_CYCLE_EPS *
     eps)``, which is cheaper but leaves V^c the discretisation error of the cycle near

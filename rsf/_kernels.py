@@ -1,7 +1,7 @@
 r"""Small, pure numba kernels: steady-state laws, the stick and slip roots, the phase
 decision and the right-hand sides handed to CVODE.
 
-Conventions (see ``docs/rsf.md``):
+Conventions (see ``docs/reference/rsf.md``):
 
 * a steady-state law is evaluated by ``law_eval(v, p) -> (mu_ss(v) - mu_ref, W(v))``:
   ``p[0]`` is the law's integer code (``KIND_*``) and ``p[1:]`` its parameters;

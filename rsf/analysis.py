@@ -1,7 +1,7 @@
 r"""Linear stability of steady sliding, and the scaling of the stick-slip amplitude near the
 bifurcation.
 
-Stability (``docs/rsf.md`` has the derivation).  Linearising the spring-slider about
+Stability (``docs/reference/rsf.md`` has the derivation).  Linearising the spring-slider about
 steady sliding at :math:`V` (:math:`\theta = D_c/V`) gives, for the aging law (Eq. 8),
 any direct effect :math:`a \ge 0` and the slip law alike, a trace proportional to
 :math:`W(V) - k_0 D_c` with :math:`W(V) = -V\,\mathrm{d}\mu_{ss}/\mathrm{d}V`: steady sliding
@@ -94,7 +94,7 @@ def steady_jacobian(model: SpringSlider, V: float) -> np.ndarray:
     r"""Jacobian of the spring-slider linearised about steady sliding at ``V``, for
     :math:`a > 0`, in the relative perturbations :math:`\xi = \delta v/V`,
     :math:`\psi = \delta\theta/\theta` and the time :math:`\tau = Vt/D_c`
-    (``docs/rsf.md``, "Radiation damping"):
+    (``docs/reference/rsf.md``, "Radiation damping"):
 
     .. math::
         \frac{\mathrm{d}}{\mathrm{d}\tau}\begin{pmatrix}\xi\\ \psi\end{pmatrix}

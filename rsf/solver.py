@@ -1,7 +1,7 @@
 r"""Orchestration: the event-driven integration of the spring-slider.
 
 With no direct effect (:math:`a = 0`, the paper's model, Eqs. 8, 11, 12) the motion is a
-sequence of phases (``docs/rsf.md`` has the derivation):
+sequence of phases (``docs/reference/rsf.md`` has the derivation):
 
 * **stick** (:math:`v = 0`, :math:`\sigma < \phi(\theta)`): closed form,
   :math:`\theta = \theta_0 + t`, :math:`\sigma = \sigma_0 + k_0 V t`; its end is the first

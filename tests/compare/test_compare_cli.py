@@ -76,7 +76,11 @@ def test_quick_report_end_to_end(tmp_path):
     for heading in ("D_c", "Critical velocity", "Hopf", "Phase", "Slide-hold-slide"):
         assert heading in summary
     again = _run(["--quick", "--out", str(out)], tmp_path / "cache", 900)   # every micro point cached
-    assert "0 micro tasks computed" in again.stdout
+    assert again.returncode == 0, again.stderr
+    assert "(0 micro tasks computed" in (out / "summary.md").read_text()
+    # one line says where the report is; the summary is not echoed (it was, whole)
+    assert again.stdout.strip().splitlines()[-1].startswith(f"wrote {out} (")
+    assert "# micro vs rate-and-state" not in again.stdout and "## " not in again.stdout
 
 
 @pytest.mark.slow

@@ -1,24 +1,28 @@
-"""Every compare docs example runs (quick settings) and writes its figure."""
+"""Every compare docs example (docs/examples/plot_compare_*.py) runs: the four figure
+examples write their figure with the quick settings, the D_c example fits from scratch."""
 from __future__ import annotations
 
-import runpy
-import sys
 from pathlib import Path
 
 import pytest
 
-EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "docs" / "examples").glob("compare_*.py"))
+EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "docs" / "examples").glob("plot_compare_*.py"))
+FIGURES = ("bifurcation", "hopf", "phase", "shs")
 
 
 def test_there_is_one_example_per_figure():
-    assert {p.stem for p in EXAMPLES} == {f"compare_{n}" for n in ("bifurcation", "hopf", "phase", "shs")}
+    assert {p.stem for p in EXAMPLES} == {f"plot_compare_{n}" for n in FIGURES + ("fit_dc",)}
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.name)
-def test_example_runs(path, tmp_path, monkeypatch):
+def test_example_runs(path, run_example, tmp_path, monkeypatch):
     monkeypatch.setenv("COMPARE_CACHE_DIR", str(tmp_path.parent / "compare-examples-cache"))
-    monkeypatch.setattr(sys, "argv", [str(path), str(tmp_path), "--quick"])
-    runpy.run_path(str(path), run_name="__main__")
-    figure = tmp_path / (path.stem.removeprefix("compare_") + ".png")
-    assert figure.exists() and figure.stat().st_size > 10_000
+    namespace, figures = run_example(path)
+    assert figures and all(fig.axes and fig.axes[0].has_data() for fig in figures)
+    name = path.stem.removeprefix("plot_compare_")
+    if name in FIGURES:
+        figure = Path(namespace["rep"].figures[name])
+        assert figure.exists() and figure.stat().st_size > 10_000
+    else:
+        assert 0.01 < namespace["dc"].Dc < 0.5 and 0.01 < namespace["crit"].Dc < 0.5

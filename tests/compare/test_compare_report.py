@@ -1,5 +1,5 @@
 """The quick report's scientific outputs against values computed independently of it:
-closed forms, analytic limits, the N-block's bracket of V^c (docs/micro_nblock.md)."""
+closed forms, analytic limits, the N-block's bracket of V^c (docs/reference/micro_nblock.md)."""
 from __future__ import annotations
 
 import math

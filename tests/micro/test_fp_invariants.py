@@ -141,7 +141,7 @@ def test_steady_at_k0_001_V_1000_and_the_grids_oscillation_there_is_flagged():
     assert bool(exact.stable) and float(exact.branching_ratio) < 0.995
     auto = micro.stationary(model, 1000.0)
     assert auto.regime == "steady" and auto.sigma_mean == pytest.approx(float(exact.sigma), abs=1e-10)
-    # A known limit of the FP (docs/micro_results.md): at its coarsest bin the grid keeps
+    # A known limit of the FP (docs/validation/micro_results.md): at its coarsest bin the grid keeps
     # a converged oscillation of stress drop ~5 k0 eps (amplitude ~ eps^2).  If it is
     # there, the result must say it may be the grid's and the bisection must not count
     # it as stick-slip; either way the mean stress is the steady one to the FP's error

@@ -52,7 +52,7 @@ def test_converges_as_eps_shrinks():
     # tests/micro/test_renewal.py): errors -5.8e-5, -2.8e-5, -1.6e-5 at eps = 0.02, 0.01,
     # 0.005 (the stress's standard error 1.2e-6 at the finest), about first order.  A run
     # that did not move from its frozen start is off by O(1e-2); the FP's error does not
-    # reach 1e-5 here (docs/micro_renewal.md, section 4)
+    # reach 1e-5 here (docs/reference/micro_renewal.md, section 4)
     model = micro.Model(k0=0.1)
     exact = float(micro.steady_sliding(model, 2.0, growth_rate=False).sigma)
     errors = [_steady(model, 2.0, eps) - exact for eps in (0.02, 0.01, 0.005)]

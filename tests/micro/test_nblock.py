@@ -403,12 +403,12 @@ def test_slow_stick_slip_extrema_converge_in_n():
 
 
 def test_docs_example_runs():
-    """The example at the top of docs/micro_nblock.md runs as written."""
-    text = (Path(__file__).resolve().parents[2] / "docs" / "micro_nblock.md").read_text()
+    """The example at the top of docs/reference/micro_nblock.md runs as written."""
+    text = (Path(__file__).resolve().parents[2] / "docs" / "reference" / "micro_nblock.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
     assert blocks
     for code in blocks:
         namespace: dict = {}
-        exec(compile(code, "docs/micro_nblock.md", "exec"), namespace)
+        exec(compile(code, "docs/reference/micro_nblock.md", "exec"), namespace)
     assert namespace["cycle"].regime == "stick-slip"
     assert namespace["steady"].sigma_stderr > 0.0

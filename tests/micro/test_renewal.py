@@ -2,7 +2,7 @@
 independent Monte Carlo of the same blocks, its own limits, and the FP / N-block V^c.
 
 Every reference here shares no code with micro.renewal: the closed forms are
-micro.analytic's (derived independently in docs/micro_model.md), the Monte Carlo below
+micro.analytic's (derived independently in docs/reference/micro_model.md), the Monte Carlo below
 time-steps the blocks' equations with a plain numpy loop.
 """
 from __future__ import annotations
@@ -166,7 +166,7 @@ def test_growth_rate_diverges_at_the_critical_velocity():
 
 
 def test_critical_velocity_inside_the_fokker_planck_and_n_block_brackets():
-    # independent brackets (docs/micro_numerics.md §5, micro_results.md): FP bisection with
+    # independent brackets (docs/reference/micro_numerics.md §5, docs/validation/micro_results.md): FP bisection with
     # the check at eps/2 and N-block amplitudes: k0 = 0.3: 0.19-0.21 (FP 0.186-0.191),
     # k0 = 0.1: 0.70-0.75 (FP 0.725-0.744), k0 = 0.01: 7.5-8.0 (FP 7.85-7.95)
     expected = {0.3: (0.18, 0.21), 0.1: (0.70, 0.75), 0.01: (7.5, 8.1)}
