@@ -31,6 +31,8 @@ log = logging.getLogger("micro")
 #: k0 ~ 1e-8; beyond these the stresses lose every significant digit).
 V_RANGE = (1e-6, 1e7)
 K0_MAX = 1e3
+#: Longest simulated time a command accepts (as rsf's t_end): 1e8 relaxation times.
+T_MAX = 1e8
 
 
 def _floats(text: str, name: str, low: float, high: float) -> list[float]:
@@ -81,16 +83,36 @@ def _write_csv(frame: pd.DataFrame, out: Path) -> None:
         raise
 
 
+def _bounded(value: float, name: str, low: float, high: float, *, open_low: bool = False) -> float:
+    """``value`` finite and in [low, high] (``(low, high]`` with ``open_low``), or one error
+    naming the option."""
+    ok = math.isfinite(value) and (low < value if open_low else low <= value) and value <= high
+    if not ok:
+        raise ValueError(f"{name} must be in {'(' if open_low else '['}{low:g}, {high:g}], got {value!r}")
+    return value
+
+
 def _schedule(text: str) -> Drive:
-    """``V1:T1,V2:T2,...``: drive at V1 for T1, then V2 for T2, ..."""
+    """``V1:T1,V2:T2,...``: drive at V1 for T1, then V2 for T2, ... (each V in [0, 1e7], each
+    T in (0, 1e8], the total within 1e8)."""
     segments = []
-    for part in text.split(","):
+    parts = text.split(",")
+    for i, part in enumerate(parts):
         try:
-            v, d = part.split(":")
-            segments.append((float(d), float(v)))
+            v, d = (float(x) for x in part.split(":"))
         except ValueError:
             raise argparse.ArgumentTypeError(f"--schedule must look like V1:T1,V2:T2, got {text!r}") from None
+        _bounded(v, f"--schedule item {i + 1} velocity", 0.0, V_RANGE[1])
+        _bounded(d, f"--schedule item {i + 1} duration", 0.0, T_MAX, open_low=True)
+        segments.append((d, v))
+    _bounded(sum(d for d, _ in segments), "--schedule total duration", 0.0, T_MAX, open_low=True)
     return Drive.schedule(segments)
+
+
+def _progress(i: int, n: int, elapsed: float) -> str:
+    """``[i/n, elapsed, ETA]`` of a list of points, the ETA from the mean time per point."""
+    eta = f", ETA {elapsed / i * (n - i):.0f} s" if i < n else ""
+    return f"[{i}/{n}, {elapsed:.0f} s{eta}]"
 
 
 def _model_options(p: argparse.ArgumentParser, *, k0_list: bool = False) -> None:
@@ -114,7 +136,7 @@ def _model_options(p: argparse.ArgumentParser, *, k0_list: bool = False) -> None
                    help="bin width of delta_F and delta_R (default kappa*zbar/50; error ~ (eps/0.004)^2 * 1.4e-4 on a steady stress)")
     n.add_argument("--rtol", type=float, default=1e-2,
                    help="convergence: relative agreement of 3 cycles / stress means (default 1e-2, the paper's)")
-    n.add_argument("--t-max", type=float, default=None, help="longest simulated time (default from the model's time scales)")
+    n.add_argument("--t-max", type=float, default=None, help="longest simulated time, <= 1e8 (default from the model's time scales)")
 
 
 def _model(args, k0: float) -> Model:
@@ -146,7 +168,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("sweep", help="stationary state for each drive velocity: one CSV row per V")
     _model_options(s)
-    s.add_argument("--V", required=True, help="drive velocities, comma-separated, each > 0")
+    s.add_argument("--V", required=True, help="drive velocities, comma-separated, each in [1e-6, 1e7]")
     s.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,V,regime,sigma_max,sigma_min,sigma_mean,...")
 
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
@@ -168,11 +190,11 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("run", help="stress time series of one protocol: columns t,w,sigma")
     _model_options(r)
     drive = r.add_mutually_exclusive_group(required=True)
-    drive.add_argument("--V", type=float, help="constant drive velocity (with --duration)")
-    drive.add_argument("--schedule", help="piecewise drive V1:T1,V2:T2,... (velocity:duration, V >= 0)")
+    drive.add_argument("--V", type=float, help="constant drive velocity in [1e-6, 1e7] (with --duration)")
+    drive.add_argument("--schedule", help="piecewise drive V1:T1,V2:T2,... (velocity:duration, V in [0, 1e7], total T <= 1e8)")
     drive.add_argument("--shs", nargs=4, type=float, metavar=("V", "SLIDE", "HOLD", "RESUME"),
                        help="slide-hold-slide: drive at V for SLIDE, hold for HOLD, resume for RESUME")
-    r.add_argument("--duration", type=float, help="run length for --V")
+    r.add_argument("--duration", type=float, help="run length for --V, in (0, 1e8]")
     r.add_argument("--out", required=True, help="output CSV: t,w,sigma (plus window min/max/mean)")
     return p
 
@@ -197,6 +219,8 @@ def _run(args) -> int:
     models = [_model(args, k0) for k0 in k0s]
     if models[0].k0 > K0_MAX:
         raise ValueError(f"--k0 must be in (0, {K0_MAX:g}], got {args.k0!r}")
+    if args.t_max is not None:
+        _bounded(args.t_max, "--t-max", 0.0, T_MAX, open_low=True)
     numerics, convergence = _numerics(args)
     for model in models:
         numerics.settings(model)
@@ -214,7 +238,7 @@ def _run(args) -> int:
         for i, V in enumerate(velocities):
             res = stationary(models[0], V, numerics=numerics, convergence=convergence)
             rows.append(res.to_dict())
-            print(f"[{i + 1}/{len(velocities)}, {time.perf_counter() - start:.0f} s] V={V:g}: {res.regime}, "
+            print(f"{_progress(i + 1, len(velocities), time.perf_counter() - start)} V={V:g}: {res.regime}, "
                   f"sigma_max={res.sigma_max:.6f}, sigma_min={res.sigma_min:.6f}"
                   f"{'' if res.converged else ' (NOT converged: ' + res.message + ')'}", file=sys.stderr)
         frame = pd.DataFrame(rows)
@@ -228,7 +252,7 @@ def _run(args) -> int:
                                      numerics=numerics, convergence=convergence, refine=args.refine,
                                      method=args.method)
             rows.append(crit.to_dict())
-            print(f"[{i + 1}/{len(models)}, {time.perf_counter() - start:.0f} s] k0={model.k0:g}: "
+            print(f"{_progress(i + 1, len(models), time.perf_counter() - start)} k0={model.k0:g}: "
                   f"Vc={crit.Vc:.6g} ({crit.status})", file=sys.stderr)
         _write_csv(pd.DataFrame(rows), out)
         print(f"wrote {len(rows)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
@@ -237,11 +261,16 @@ def _run(args) -> int:
     if args.V is not None:
         if args.duration is None:
             raise ValueError("--duration is required with --V")
-        drive = Drive.uniform(args.V, args.duration)
+        drive = Drive.uniform(_bounded(args.V, "--V", *V_RANGE),
+                              _bounded(args.duration, "--duration", 0.0, T_MAX, open_low=True))
     elif args.schedule is not None:
         drive = _schedule(args.schedule)
     else:
         v, slide, hold, resume = args.shs
+        _bounded(v, "--shs V", *V_RANGE)
+        for name, value in (("SLIDE", slide), ("HOLD", hold), ("RESUME", resume)):
+            _bounded(value, f"--shs {name}", 0.0, T_MAX, open_low=name != "HOLD")
+        _bounded(slide + hold + resume, "--shs SLIDE + HOLD + RESUME", 0.0, T_MAX, open_low=True)
         drive = Drive.slide_hold_slide(v, slide, hold, resume)
     run = simulate(models[0], drive, numerics=numerics)
     _write_csv(run.records, out)

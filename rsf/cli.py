@@ -93,6 +93,9 @@ def _check_magnitudes(args: argparse.Namespace) -> None:
 
 
 def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> None:
+    # -v also after the subcommand (SUPPRESS: an absent sub-level flag keeps the top-level one)
+    p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+                   help="log progress (INFO)")
     g = p.add_argument_group("model")
     if k0_list:
         g.add_argument("--k0", type=_floats, required=True,

@@ -120,7 +120,18 @@ def test_micro_sweep_and_critical_report_each_point_as_it_finishes(tmp_path, cap
 
     assert main(["sweep", "--k0", "0.1", "--V", "2,5", "--out", str(tmp_path / "s.csv")]) == 0
     lines = capsys.readouterr().err.splitlines()
-    assert re.match(r"^\[1/2, \d+ s\] V=2: steady, sigma_max=0\.89", lines[0]) and lines[1].startswith("[2/2, ")
+    # the first point's line carries an ETA for the rest; the last one none
+    assert re.match(r"^\[1/2, \d+ s, ETA \d+ s\] V=2: steady, sigma_max=0\.89", lines[0])
+    assert re.match(r"^\[2/2, \d+ s\] V=5", lines[1])
     assert main(["critical", "--k0", "0.3,0.1", "--out", str(tmp_path / "c.csv"), "-v"]) == 0
     lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("[")]
     assert [line.split("]")[0] for line in lines][0].startswith("[1/2") and "k0=0.1: Vc=0.727504" in lines[1]
+
+
+def test_rsf_takes_verbose_after_the_subcommand(tmp_path):
+    # issue 18 item 6: '-v' was accepted only before the subcommand in rsf
+    from rsf.cli import build_parser
+
+    for argv in (["sweep", "--k0", "0.1", "--V", "1", "-v"], ["-v", "sweep", "--k0", "0.1", "--V", "1"]):
+        assert build_parser().parse_args(argv).verbose is True
+    assert build_parser().parse_args(["sweep", "--k0", "0.1", "--V", "1"]).verbose is False

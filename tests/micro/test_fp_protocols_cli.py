@@ -117,6 +117,13 @@ def test_cli_run_slide_hold_slide_and_constant_velocity(tmp_path):
     (["steady", "--k0", "0.1", "--V", "1", "--out", "/proc/x.csv"], "cannot write in '/proc'"),
     (["steady", "--k0", "0.1", "--V", "1", "--out", "/"], "is a directory"),
     (["steady", "--k0", "0.1", "--V", "1", "--out", "/nonexistent-dir/x.csv"], "does not exist"),
+    # run: each of these was accepted and ran for ever (a simulated time of 1e12)
+    (["run", "--k0", "0.3", "--V", "1", "--duration", "1e12"], r"--duration must be in \(0, 1e\+08\]"),
+    (["run", "--k0", "0.3", "--V", "1e9", "--duration", "1"], r"--V must be in \[1e-06, 1e\+07\]"),
+    (["run", "--k0", "0.3", "--shs", "1", "1e12", "10", "20"], r"--shs SLIDE must be in \(0, 1e\+08\]"),
+    (["run", "--k0", "0.3", "--schedule", "1:1e12"], r"--schedule item 1 duration must be in \(0, 1e\+08\]"),
+    (["run", "--k0", "0.3", "--schedule", "1:10,nan:5"], r"--schedule item 2 velocity must be in \[0, 1e\+07\]"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--t-max", "1e300"], r"--t-max must be in \(0, 1e\+08\]"),
 ])
 def test_every_input_is_checked_before_computing(argv, match, tmp_path, capsys):
     # each of these used to compute first (sweep --V 5,nan: 228 s) and fail on writing or on
