@@ -19,6 +19,7 @@ the points, cached ones included.
 """
 from __future__ import annotations
 
+import contextlib
 import logging
 import multiprocessing
 import os
@@ -27,7 +28,7 @@ import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Iterator, Sequence
 
 from tqdm.auto import tqdm
 
@@ -96,6 +97,25 @@ def _die_with_parent(parent_pid: int) -> None:
         os._exit(1)
 
     threading.Thread(target=watch, name="parent-watch", daemon=True).start()
+
+
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM until the block is done, then raise KeyboardInterrupt if one
+    came (in the main thread only: elsewhere signals are not delivered to Python code)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = {sig: signal.signal(sig, lambda signum, frame: caught.append(signum))
+                for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if caught:
+        raise KeyboardInterrupt
 
 
 class Runner:
@@ -241,7 +261,11 @@ class Runner:
         saved = {var: os.environ.get(var) for var in _BLAS_THREADS}
         os.environ.update({var: "1" for var in _BLAS_THREADS})
         try:
-            pending: set[Future] = {self._pool.submit(execute, task) for task in todo}
+            # submit() spawns the workers: a Ctrl-C or SIGTERM in the middle of writing a new
+            # worker's start-up data to its pipe left that worker to die printing a traceback
+            # ("EOFError: Ran out of input"); the signal is acted on once the submits are done
+            with _signals_deferred():
+                pending: set[Future] = {self._pool.submit(execute, task) for task in todo}
         finally:
             for var, value in saved.items():
                 if value is None:
