@@ -141,3 +141,34 @@ def test_killed_run_leaves_no_worker_behind(sig, tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+@pytest.mark.parametrize("argv, settings, kwargs", [
+    ([], "default", dict(Dc=None, use_cache=True, workers=None, scheduler=None, progress=True, cache_dir=None)),
+    (["--quick", "--no-cache", "--workers", "3", "--no-progress"], "quick",
+     dict(use_cache=False, workers=3, progress=False)),
+    (["--paper", "--dc", "0.07", "--cache-dir", "C", "--scheduler", "tcp://h:1"], "paper",
+     dict(Dc=0.07, cache_dir="C", scheduler="tcp://h:1")),
+])
+def test_every_option_reaches_the_report(argv, settings, kwargs, tmp_path, monkeypatch, capsys):
+    # the preset and each option as compare.report receives them, without computing: a flag
+    # that parsed but went nowhere (--paper running the default preset, --no-cache still
+    # caching, --workers ignored) passes every end-to-end test that only checks exit codes
+    import compare.cli as cli
+    from compare import Settings
+
+    seen = {}
+
+    def fake_report(s, **kw):
+        seen.update(settings=s, **kw)
+        return type("R", (), {"out": tmp_path, "tables": {}, "figures": {}, "wall_time": 0.0})()
+
+    monkeypatch.setattr(cli, "report", fake_report)
+    extra = ["--k0", "0.2", "0.05", "--eps", "0.015", "--scenario", "phase", "--scenario", "shs"]
+    assert cli.main([*argv, *extra, "--out", str(tmp_path / "r")]) == 0
+    want = getattr(Settings, settings)(k0=(0.2, 0.05), eps=0.015, scenarios=("phase", "shs"))
+    assert seen.pop("settings") == want and want.preset == settings
+    assert seen.pop("out") == str(tmp_path / "r")
+    for name, value in kwargs.items():
+        assert seen[name] == value, name
+    assert "wrote" in capsys.readouterr().out
