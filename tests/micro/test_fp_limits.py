@@ -34,17 +34,34 @@ def test_mean_dashpot_stretch_stays_zero_in_steady_sliding():
     # <delta_R> = k2 <u> only relaxes (jumps keep u): a scheme that lets it drift by
     # O(eps^2) per jump is off by (jump rate) eps^2 / gamma, which grows with V
     # (about 500 per unit time here: jump rate V/zbar = 2000, eps^2 = 2.6e-4, gamma = 0.9).
-    # The start has <delta_R> = 0 by construction and a stress 1.5e-4 from the answer; the
-    # FP ends 6e-5 from it, so a run that did not move fails the second assert.
+    # Every start has <delta_R> = 0, so the stress shows that the solver moved: from the
+    # "uniform" start, 0.1 above the answer (the default start is only 1.5e-4 off), the FP
+    # ends 6e-5 from it, so a run that did not move is 1000 times the tolerance off.
     exact = micro.sigma_fast_limit(STIFF, 200.0)
     numerics = micro.Numerics(eps=0.016)
-    start = Grid(STIFF, numerics.settings(STIFF), initial="frozen")
-    assert abs(start.sigma_grid - exact) > 1.4e-4
-    res = micro.stationary(STIFF, 200.0, numerics=numerics, keep_grid=True, method="fp")
+    start = Grid(STIFF, numerics.settings(STIFF), initial="uniform")
+    assert abs(start.sigma_grid - exact) > 0.09
+    res = micro.stationary(STIFF, 200.0, numerics=numerics, keep_grid=True, method="fp", initial="uniform")
+    assert res.converged and res.regime == "steady", res.message
     cells = res.grid.cells()
     mean_dr = float((cells["mass"] * cells["delta_R"]).sum())
     assert abs(mean_dr) < 1e-4
     assert res.sigma_mean == pytest.approx(exact, abs=1e-4)
+
+
+def test_small_velocity_stress_with_its_eta_u_V_term():
+    # k0 > k2 at V = 0.05: the exact stress (direct method) is 0.033 below the V -> 0 limit
+    # f_th - (k0 + k1) <z^2>/(2<z>) (the -eta_u V term, 0.05, and its O(V^2) remainder) and
+    # 0.057 above the fast limit, where the default start sits.  The FP at the coarse bin
+    # meets it to 3.6e-4 (6 s); a solver that did not move, lost eta_u or relaxed the dashpots
+    # wrongly is off by > 0.03, 30 times the tolerance.  (The slow test goes to V = 0.002.)
+    V = 0.05
+    exact = float(micro.steady_sliding(STIFF, V, growth_rate=False).sigma)
+    assert micro.sigma_slow_limit(STIFF, 0.0) - exact > 0.03
+    assert exact - micro.sigma_fast_limit(STIFF) > 0.05
+    start = Grid(STIFF, micro.Numerics(eps=0.025).settings(STIFF))
+    assert abs(start.sigma_grid - exact) > 0.05
+    assert _steady(STIFF, V, 0.025) == pytest.approx(exact, abs=1e-3)
 
 
 def test_converges_as_eps_shrinks():
