@@ -107,7 +107,8 @@ def test_fast_steady_sliding_has_no_shocks():
     assert len(late) == 0
     settled = run.records[run.records.t > 1.0]
     assert settled.sigma.max() - settled.sigma.min() < 20 * model.k0 * 0.016
-    assert settled.sigma.mean() == pytest.approx(micro.sigma_fast_limit(model, 57.6), abs=1e-4)
+    # 2.1e-5 off (the start, the V -> inf state, is 1.4e-4 below: a run that did not move fails)
+    assert settled.sigma.mean() == pytest.approx(micro.sigma_fast_limit(model, 57.6), abs=5e-5)
 
 
 def test_a_slow_loading_phase_is_not_taken_for_steady_sliding():
