@@ -14,10 +14,8 @@ import rsf
 
 
 @pytest.fixture(scope="module")
-def rep(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("quick")
-    return compare.report(compare.Settings.quick(), out=tmp / "report", cache_dir=tmp / "cache", workers=1,
-                          progress=False)
+def rep(quick_report):
+    return quick_report[0]   # tests/compare/conftest.py
 
 
 def test_critical_velocity_table_has_all_five_k0_and_the_kept_columns(rep):
