@@ -282,7 +282,8 @@ def test_vc_curves_over_k0(rep):
             columns["Vc_rs_paper"] = (rsf.PAPER_A, rsf.PAPER_B, rsf.PAPER_DC)
         for col, (a, b, dc) in columns.items():
             want = _rs_vc(a, b, r.k0, dc)
-            assert (math.isnan(want) and not np.isfinite(r[col])) or r[col] == pytest.approx(want, rel=1e-9), (col, r.k0)
+            ok = not np.isfinite(r[col]) if math.isnan(want) else r[col] == pytest.approx(want, rel=1e-9)
+            assert ok, (col, r.k0)
     for i in (0, len(vc) // 2, len(vc) - 1):
         r = vc.iloc[i]
         b = float(micro.steady_sliding(micro.Model(k0=float(r.k0)), r.Vc_micro, growth_rate=False).branching_ratio)
