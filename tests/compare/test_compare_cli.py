@@ -7,6 +7,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -52,15 +53,33 @@ def test_shs_scenario_end_to_end(tmp_path):
     assert best["RS Eq. (11)"] == "algebraic"
     assert best["classical RS Eq. (7)"] == "logarithmic"
     assert "Slide-hold-slide" in (out / "summary.md").read_text()
+    # values: RS Eq. (11) (a = 0, the state ages as d theta/dt = 1 in a hold) peaks between the
+    # closed forms A/(D_c/(D_c/V + hold) + B) - A/(V + B) and A/B - A/(V + B), with the A, B of
+    # steady_fit.csv and the D_c given; A and B near those of the exact branch (0.00756, 0.0838)
+    law = pd.read_csv(out / "steady_fit.csv").iloc[0]
+    A, B, Dc, V = law.A, law.B, 0.06, 3.0
+    assert A == pytest.approx(0.0076, rel=0.05) and B == pytest.approx(0.084, rel=0.05)
+    rs = pd.read_csv(out / "shs_points.csv").query("model == 'RS Eq. (11)'")
+    hold, d = rs.hold_time.to_numpy(), rs.delta_sigma_max.to_numpy()
+    assert len(d) == 4
+    assert np.all(d >= (A / (Dc / (Dc / V + hold) + B) - A / (V + B)) * (1 - 1e-6))
+    assert np.all(d <= (A / B - A / (V + B)) * (1 + 1e-9))
 
-    # the same without the cache and in this process: every point recomputed, the same table
+
+@pytest.mark.slow  # a second end-to-end run (25 s); test_every_option_reaches_the_report checks the flags
+def test_no_cache_serial_run_recomputes_the_same_table(tmp_path):
+    # the same as a cached pooled run, without the cache and in this process: every point
+    # recomputed, the same table
+    args = ["--quick", "--scenario", "shs", "--dc", "0.06", "--out"]
+    proc = _run([*args, str(tmp_path / "first")], tmp_path / "cache", 300)
+    assert proc.returncode == 0, proc.stderr
     again = tmp_path / "again"
-    proc = _run(["--quick", "--scenario", "shs", "--dc", "0.06", "--no-cache", "--workers", "1", "--out", str(again)],
-                tmp_path / "cache", 300)
+    proc = _run([*args, str(again), "--no-cache", "--workers", "1"], tmp_path / "cache", 300)
     assert proc.returncode == 0, proc.stderr
     text = (again / "summary.md").read_text()
     assert " 0 from the cache" in text and " 0 micro tasks computed" not in text
-    pd.testing.assert_frame_equal(pd.read_csv(again / "shs_fit.csv"), fit, rtol=1e-12)
+    pd.testing.assert_frame_equal(pd.read_csv(again / "shs_fit.csv"), pd.read_csv(tmp_path / "first" / "shs_fit.csv"),
+                                  rtol=1e-12)
 
 
 @pytest.mark.slow
@@ -145,3 +164,34 @@ def test_killed_run_leaves_no_worker_behind(sig, tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+@pytest.mark.parametrize("argv, settings, kwargs", [
+    ([], "default", dict(Dc=None, use_cache=True, workers=None, scheduler=None, progress=True, cache_dir=None)),
+    (["--quick", "--no-cache", "--workers", "3", "--no-progress"], "quick",
+     dict(use_cache=False, workers=3, progress=False)),
+    (["--paper", "--dc", "0.07", "--cache-dir", "C", "--scheduler", "tcp://h:1"], "paper",
+     dict(Dc=0.07, cache_dir="C", scheduler="tcp://h:1")),
+])
+def test_every_option_reaches_the_report(argv, settings, kwargs, tmp_path, monkeypatch, capsys):
+    # the preset and each option as compare.report receives them, without computing: a flag
+    # that parsed but went nowhere (--paper running the default preset, --no-cache still
+    # caching, --workers ignored) passes every end-to-end test that only checks exit codes
+    import compare.cli as cli
+    from compare import Settings
+
+    seen = {}
+
+    def fake_report(s, **kw):
+        seen.update(settings=s, **kw)
+        return type("R", (), {"out": tmp_path, "tables": {}, "figures": {}, "wall_time": 0.0})()
+
+    monkeypatch.setattr(cli, "report", fake_report)
+    extra = ["--k0", "0.2", "0.05", "--eps", "0.015", "--scenario", "phase", "--scenario", "shs"]
+    assert cli.main([*argv, *extra, "--out", str(tmp_path / "r")]) == 0
+    want = getattr(Settings, settings)(k0=(0.2, 0.05), eps=0.015, scenarios=("phase", "shs"))
+    assert seen.pop("settings") == want and want.preset == settings
+    assert seen.pop("out") == str(tmp_path / "r")
+    for name, value in kwargs.items():
+        assert seen[name] == value, name
+    assert "wrote" in capsys.readouterr().out

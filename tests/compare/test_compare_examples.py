@@ -26,3 +26,19 @@ def test_example_runs(path, run_example, tmp_path, monkeypatch):
         assert figure.exists() and figure.stat().st_size > 10_000
     else:
         assert 0.01 < namespace["dc"].Dc < 0.5 and 0.01 < namespace["crit"].Dc < 0.5
+
+
+@pytest.mark.parametrize("path", [p for p in EXAMPLES if p.stem.removeprefix("plot_compare_") in FIGURES],
+                         ids=lambda p: p.name)
+def test_example_runs_on_the_quick_reports_cache(path, quick_report, run_example, monkeypatch):
+    # the cheap default version of test_example_runs: every micro point of the quick preset is
+    # in the session's cache (tests/compare/conftest.py), so each example only redoes the RS
+    # side, the fits and its figure (~2 s); its summary says that nothing was recomputed
+    _, cache = quick_report
+    monkeypatch.setenv("COMPARE_CACHE_DIR", str(cache))
+    namespace, figures = run_example(path)
+    assert figures and all(fig.axes and fig.axes[0].has_data() for fig in figures)
+    rep = namespace["rep"]
+    figure = Path(rep.figures[path.stem.removeprefix("plot_compare_")])
+    assert figure.exists() and figure.stat().st_size > 10_000
+    assert "(0 micro tasks computed" in rep.summary

@@ -56,27 +56,72 @@ def test_cli_sweep_and_run_write_the_documented_columns(tmp_path):
 
 
 def test_cli_critical_writes_the_documented_columns(tmp_path):
-    # a coarse bin, a loose tolerance, V_min = 0.02 and no check at eps/2 keep this to seconds
+    # the entry point, direct method (the default): V^c at k0 = 0.3 where micro's exact
+    # branching ratio is 1 (checked here), and no V^c for k0 >= k2
     out = tmp_path / "vc.csv"
-    res = _cli("critical", "--k0", "0.3,1.0", "--eps", "0.025", "--rel-tol", "0.3", "--V-min", "0.02", "--no-refine",
-               "--out", str(out), cwd=tmp_path)
+    res = _cli("critical", "--k0", "0.3,1.0", "--out", str(out), cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     table = pd.read_csv(out)
     for col in "k0,k1,k2,zbar,Vc".split(","):
         assert col in table.columns
     stick, never = table.iloc[0], table.iloc[1]
-    assert stick.status == "converged" and stick.V_low < stick.Vc < stick.V_high <= 1.3 * stick.V_low
+    assert stick.status == "converged" and stick.V_low <= stick.Vc <= stick.V_high <= stick.V_low * (1 + 1e-8)
+    b = float(micro.steady_sliding(micro.Model(k0=0.3), stick.Vc, growth_rate=False).branching_ratio)
+    assert abs(b - 1.0) < 1e-9 and stick.Vc == pytest.approx(0.19467366989784, rel=1e-9)
     assert never.status == "no stick-slip" and never.Vc == 0.0  # k0 >= k2
     assert "--no-refine" in _cli("critical", "--help", cwd=tmp_path).stdout
 
 
-def test_cli_help_and_bad_input(tmp_path):
+def test_cli_critical_fp_options_reach_the_bisection(tmp_path, monkeypatch):
+    # --method fp and its numerics (a bisection costs 8+ s, so the call is intercepted and
+    # answered by the direct method): a dropped --no-refine, --eps or --method passes silently
+    import micro.cli as cli
+
+    seen = []
+
+    def spy(model, **kw):
+        seen.append((model, kw))
+        return micro.critical_velocity(model)
+
+    monkeypatch.setattr(cli, "critical_velocity", spy)
+    out = tmp_path / "vc.csv"
+    assert cli.main(["critical", "--k0", "0.3", "--k1", "0.2", "--k2", "0.7", "--method", "fp", "--eps", "0.02",
+                     "--rel-tol", "0.3", "--V-min", "0.02", "--no-refine", "--rtol", "0.005", "--out", str(out)]) == 0
+    (model, kw), = seen
+    assert (model.k0, model.k1, model.k2) == (0.3, 0.2, 0.7)
+    assert kw["method"] == "fp" and kw["refine"] is False and kw["numerics"].eps == 0.02
+    assert kw["rel_tol"] == 0.3 and kw["V_min"] == 0.02 and kw["convergence"].rtol == 0.005
+    assert pd.read_csv(out).Vc.iloc[0] == pytest.approx(micro.critical_velocity(model).Vc, rel=1e-12)
+
+
+def test_cli_model_options_reach_the_model(tmp_path):
+    # every model option of the CLI against Eq. (4) (deterministic jumps, closed form) at
+    # values away from the defaults: a misrouted --eta-u, --f-th, --zbar, --k1 or --k2, or a
+    # --dist that is not read, moves the stress by > 1e-2
+    from micro.cli import main as micro_main
+
+    out = tmp_path / "steady.csv"
+    assert micro_main(["steady", "--k0", "0.4", "--k1", "0.2", "--k2", "0.6", "--zbar", "0.3", "--dist", "delta",
+                       "--eta-u", "2.5", "--f-th", "0.7", "--V", "0.05,3", "--out", str(out)]) == 0
+    frame = pd.read_csv(out)
+    model = micro.Model(k0=0.4, k1=0.2, k2=0.6, eta_u=2.5, f_th=0.7, jumps=micro.Deterministic(0.3))
+    want = [micro.sigma_deterministic_steady(model, V) for V in (0.05, 3.0)]
+    np.testing.assert_allclose(frame.sigma, want, atol=1e-12)
+    default = micro.Model(k0=0.4, jumps=micro.Deterministic(0.1))
+    assert min(abs(micro.sigma_deterministic_steady(default, V) - w) for V, w in zip((0.05, 3.0), want)) > 1e-2
+    assert list(frame.zbar) == [0.3, 0.3] and list(frame.k1) == [0.2, 0.2]
+
+
+def test_cli_help_and_bad_input(tmp_path, capsys):
+    from micro.cli import main as micro_main
+
     res = _cli("sweep", "--help", cwd=tmp_path)
     assert res.returncode == 0 and "--eps" in res.stdout and "--dist" in res.stdout
-    res = _cli("sweep", "--k0", "-1", "--V", "1", "--out", str(tmp_path / "x.csv"), cwd=tmp_path)
-    assert res.returncode != 0 and "k0 must be" in res.stderr
-    res = _cli("sweep", "--k0", "0.1", "--V", "1,abc", "--out", str(tmp_path / "x.csv"), cwd=tmp_path)
-    assert res.returncode != 0 and "--V" in res.stderr
+    # in this process (a subprocess each cost ~5 s of imports)
+    assert micro_main(["sweep", "--k0", "-1", "--V", "1", "--out", str(tmp_path / "x.csv")]) == 2
+    assert "k0 must be" in capsys.readouterr().err
+    assert micro_main(["sweep", "--k0", "0.1", "--V", "1,abc", "--out", str(tmp_path / "x.csv")]) == 2
+    assert "--V" in capsys.readouterr().err
 
 
 def test_cli_run_slide_hold_slide_and_constant_velocity(tmp_path):

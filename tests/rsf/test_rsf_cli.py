@@ -60,6 +60,14 @@ def test_run_writes_series_and_events(tmp_path):
     assert list(series.columns) == ["t", "x", "sigma", "theta", "v"]
     assert list(events.columns) == ["t", "kind", "sigma", "theta", "x"]
     assert "slide->slip" in set(events.kind)
+    # values: the series is the Python API's, and every switch sits on the threshold
+    # phi(theta) = A / (D_c / theta + B) + mu_inf of the paper's law (a = 0)
+    api = rsf.simulate(rsf.SpringSlider(k0=0.3), V=0.05, t_end=20.0)
+    assert len(series) == len(api.t) and np.abs(series.sigma.to_numpy() - api.sigma).max() < 1e-12
+    law = rsf.SpringSlider(k0=0.3).law
+    switches = events[events.kind.str.contains("->")]
+    phi = law.mu_ss(rsf.params.PAPER_DC / switches.theta.to_numpy())
+    assert len(switches) >= 3 and np.abs(switches.sigma.to_numpy() - phi).max() < 1e-10
     assert main(["run", "--k0", "0.3", "--shs", "1", "5", "2", "--t-end", "12", "--out", str(out)]) == 0
     assert main(["run", "--k0", "0.3", "--steps", "1:5,3", "--t-end", "12", "--out", str(out)]) == 0
 
