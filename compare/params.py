@@ -9,7 +9,6 @@ field can be changed with :func:`dataclasses.replace` or :meth:`Settings.with_`.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
@@ -260,12 +259,10 @@ class Settings:
     def convergence(self) -> micro.Convergence:
         return micro.Convergence(rtol=self.rtol, atol=self.atol, t_max=self.t_max)
 
-    def rs_guess_vc(self, k0: float) -> float:
-        """RS critical velocity with the paper's constants (Eq. 10, D_c = 0.06)."""
-        cv = rsf.critical_velocity(rsf.HyperbolicLaw(mu_inf=0.0), k0, rsf.PAPER_DC)
-        if math.isfinite(cv.Vc):
-            return float(cv.Vc)
-        return rsf.PAPER_B  # stiff springs: no RS instability; centre the grid on V ~ B
+    def rs_paper_vc(self, k0: float) -> float:
+        """RS critical velocity with the paper's constants (Eq. 10, D_c = 0.06); NaN where
+        steady sliding is stable at every V (k0 D_c > A / (4 B))."""
+        return float(rsf.critical_velocity(rsf.HyperbolicLaw(mu_inf=0.0), k0, rsf.PAPER_DC).Vc)
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)

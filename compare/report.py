@@ -346,7 +346,7 @@ class _Study:
         dcv = self.dc_critical
         frame["Vc_rs"] = [self._rs_vc(k) for k in frame.k0]
         frame["Vc_rs_dc_vc"] = [self._rs_vc(k, dcv.Dc) for k in frame.k0]
-        frame["Vc_rs_paper"] = [self.s.rs_guess_vc(k) for k in frame.k0]
+        frame["Vc_rs_paper"] = [self.s.rs_paper_vc(k) for k in frame.k0]
         frame["rel_diff_rs"] = frame.Vc_rs / frame.Vc_micro - 1.0
         frame["rel_diff_rs_dc_vc"] = frame.Vc_rs_dc_vc / frame.Vc_micro - 1.0
         per = dcv.per_k0.set_index("k0")
@@ -393,7 +393,7 @@ class _Study:
             row = {"k0": k0, "Vc_micro": self.Vc(k0),
                    "Vc_rs": rsf.critical_velocity(law, k0, Dc).Vc,
                    "Vc_rs_dc_vc": rsf.critical_velocity(law, k0, self.dc_critical.Dc).Vc,
-                   "Vc_rs_paper": self.s.rs_guess_vc(k0)}
+                   "Vc_rs_paper": self.s.rs_paper_vc(k0)}
             rows.append(row)
         self.tables["vc_curves"] = pd.DataFrame(rows)
         if s.paper_figures:

@@ -290,9 +290,7 @@ def test_vc_curves_over_k0(rep):
         assert abs(b - 1.0) < 1e-9, r.k0
 
 
-@pytest.mark.xfail(strict=True, reason="compare bug: Vc_rs_paper (vc_curves.csv, critical_velocity.csv) is "
-                   "Settings.rs_guess_vc, which returns PAPER_B = 0.078 as a grid centre where RS with the "
-                   "paper's constants has no instability (k0 > A/(4 B D_c) = 0.374): a V^c that does not exist")
+# Vc_rs_paper used to be 0.078 (PAPER_B, a grid centre) where this V^c does not exist
 def test_rs_paper_vc_is_nan_where_rs_has_no_instability(rep):
     vc = rep["vc_curves"]
     stiff = vc[vc.k0 * rsf.PAPER_DC > rsf.PAPER_A / (4 * rsf.PAPER_B)]
