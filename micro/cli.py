@@ -272,7 +272,7 @@ def _run(args) -> int:
             _bounded(value, f"--shs {name}", 0.0, T_MAX, open_low=name != "HOLD")
         _bounded(slide + hold + resume, "--shs SLIDE + HOLD + RESUME", 0.0, T_MAX, open_low=True)
         drive = Drive.slide_hold_slide(v, slide, hold, resume)
-    run = simulate(models[0], drive, numerics=numerics)
+    run = simulate(models[0], drive, numerics=numerics, progress=True)
     _write_csv(run.records, out)
     eps = numerics.eps if numerics.eps is not None else default_eps(models[0])
     print(f"wrote {len(run.records)} rows to {out} (eps={eps:g}) in {time.perf_counter() - start:.1f} s",

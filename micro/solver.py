@@ -8,10 +8,13 @@ steady stress, or the extrema of a stick-slip cycle) and stops there.
 """
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
+import threading
 import time
 from dataclasses import dataclass, field, replace
+from typing import Iterator
 
 import numpy as np
 import pandas as pd
@@ -281,6 +284,7 @@ def simulate(
     initial="auto",
     record_dsigma: float | None = None,
     record_dt: float | None = None,
+    progress: bool = False,
 ) -> Run:
     """Run a driving protocol and return the stress time series.
 
@@ -293,6 +297,9 @@ def simulate(
         start from (it is copied).
     record_dsigma, record_dt : record the stress whenever it has moved by
         ``record_dsigma`` and at least every ``record_dt`` (defaults from the model).
+    progress : show a progress bar of the simulated time, with its ETA, on stderr (tqdm).
+        A watcher thread reads the time while the kernel runs (the kernels release the
+        GIL); the computation is the same with or without it.
 
     Returns
     -------
@@ -316,10 +323,11 @@ def simulate(
     start = time.perf_counter()
     recs, shocks = [], []
     w0 = float(grid.fst[K.F_W])
-    for seg_start, seg_end, v in drive.boundaries():
-        r, s, code = grid.advance(v, t0 + seg_end, record_dsigma=record_dsigma, record_dt=record_dt)
-        recs.append(r)
-        shocks.append(s)
+    with _progress_watch(grid, t0, drive.duration, progress):
+        for seg_start, seg_end, v in drive.boundaries():
+            r, s, code = grid.advance(v, t0 + seg_end, record_dsigma=record_dsigma, record_dt=record_dt)
+            recs.append(r)
+            shocks.append(s)
     rec = np.concatenate(recs) if recs else np.zeros((0, 5))
     shk = np.concatenate(shocks) if shocks else np.zeros((0, 4))
     t_rel = rec[:, 0] - t0
@@ -329,6 +337,34 @@ def simulate(
     shock_frame = pd.DataFrame(shk - np.array([t0, 0.0, 0.0, 0.0]), columns=["t", "sigma_before", "sigma_after", "shift"])
     checks = _density_checks(grid)
     return Run(records=records, shocks=shock_frame, grid=grid, wall_time=time.perf_counter() - start, **checks)
+
+
+@contextlib.contextmanager
+def _progress_watch(grid: Grid, t0: float, duration: float, enabled: bool) -> Iterator[None]:
+    """While the block runs, a daemon thread shows the simulated time of ``grid`` against
+    ``duration`` as a tqdm bar (with its ETA); nothing if not ``enabled``."""
+    if not enabled:
+        yield
+        return
+    from tqdm.auto import tqdm
+
+    done = threading.Event()
+
+    def watch() -> None:
+        with tqdm(total=float(duration), unit="t", desc="micro run", leave=False, mininterval=1.0,
+                  bar_format="{desc}: {percentage:3.0f}% t = {n:.4g} of {total:.4g} "
+                             "[{elapsed} elapsed, ETA {remaining}]") as bar:
+            while not done.wait(0.5):
+                now = min(max(float(grid.fst[K.F_T]) - t0, 0.0), float(duration))
+                bar.update(now - bar.n)  # drawn at most once a second (mininterval)
+
+    thread = threading.Thread(target=watch, name="micro-progress", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        done.set()
+        thread.join()
 
 
 def _drive_position(drive: Drive, t: float) -> float:

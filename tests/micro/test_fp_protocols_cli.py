@@ -190,3 +190,13 @@ def test_critical_with_the_fp_answers_k0_above_k2_at_once(tmp_path):
     assert micro_main(["critical", "--k0", "1.0", "--method", "fp", "--out", str(out), "-v"]) == 0
     row = pd.read_csv(out).iloc[0]
     assert row.status == "no stick-slip" and row.Vc == 0.0 and "k2" in row.message
+
+
+def test_run_progress_bar_does_not_change_the_run(capsys):
+    # issue 18 item 6: `micro run` was silent for minutes; its bar is drawn by a thread that
+    # only reads the simulated time while the kernel (which releases the GIL) runs
+    model, drive = micro.Model(k0=0.3), micro.Drive.slide_hold_slide(0.05, 20.0, 10.0, 5.0)
+    plain = micro.simulate(model, drive, numerics=micro.Numerics(eps=0.025)).records
+    shown = micro.simulate(model, drive, numerics=micro.Numerics(eps=0.025), progress=True).records
+    pd.testing.assert_frame_equal(plain, shown)
+    assert "micro run" in capsys.readouterr().err
