@@ -252,7 +252,17 @@ def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: f
         roots.append(brentq(lambda x: float(law.weakening(np.array([math.exp(x)]))[0]) - K,
                             math.log(v[i]), math.log(v[i + 1]), xtol=1e-14))
     roots = [math.exp(r) for r in roots]
-    edges = [0.0] + roots + [math.inf]
+    unstable = _unstable_intervals(roots, lambda v: float(law.weakening(np.array([v]))[0]) > K)
+    if not unstable:
+        return CriticalVelocity(k0, Dc, math.nan, math.nan, tuple(roots), (), "scan")
+    lo, hi = unstable[-1]
+    return CriticalVelocity(k0, Dc, hi, lo, tuple(roots), tuple(unstable), "scan")
+
+
+def _unstable_intervals(roots: list[float], unstable_at) -> list[tuple[float, float]]:
+    """The intervals of (0, inf) between consecutive sorted ``roots`` where steady sliding is
+    unstable, each judged at one probe velocity inside it by ``unstable_at(V)``."""
+    edges = [0.0] + list(roots) + [math.inf]
     unstable = []
     for lo, hi in zip(edges[:-1], edges[1:]):
         if lo == 0.0 and hi == math.inf:
@@ -263,12 +273,9 @@ def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: f
             probe = lo * 10.0
         else:
             probe = math.sqrt(lo * hi)
-        if float(law.weakening(np.array([probe]))[0]) > K:
+        if unstable_at(probe):
             unstable.append((lo, hi))
-    if not unstable:
-        return CriticalVelocity(k0, Dc, math.nan, math.nan, tuple(roots), (), "scan")
-    lo, hi = unstable[-1]
-    return CriticalVelocity(k0, Dc, hi, lo, tuple(roots), tuple(unstable), "scan")
+    return unstable
 
 
 def _critical_velocity_scan(model: SpringSlider, v_min: float, v_max: float) -> CriticalVelocity:
@@ -291,19 +298,7 @@ def _critical_velocity_scan(model: SpringSlider, v_min: float, v_max: float) -> 
                               rtol=4 * np.finfo(float).eps))
               for i in np.flatnonzero(sign[:-1] * sign[1:] < 0)]
     roots.sort()
-    edges = [0.0] + roots + [math.inf]
-    unstable = []
-    for lo, hi in zip(edges[:-1], edges[1:]):
-        if lo == 0.0 and hi == math.inf:
-            probe = 1.0
-        elif lo == 0.0:
-            probe = hi / 10.0
-        elif hi == math.inf:
-            probe = lo * 10.0
-        else:
-            probe = math.sqrt(lo * hi)
-        if stability_margin(model, probe) > 0.0:
-            unstable.append((lo, hi))
+    unstable = _unstable_intervals(roots, lambda v: stability_margin(model, v) > 0.0)
     k0, Dc = model.k0, model.Dc
     if not unstable:
         return CriticalVelocity(k0, Dc, math.nan, math.nan, tuple(roots), (), "scan")
