@@ -92,10 +92,9 @@ class SpringSlider:
         object.__setattr__(self, "a", nonnegative("a", a))
         state = state_law_from(self.state_law)
         object.__setattr__(self, "state", state)
-        if isinstance(self.state_law, str):
-            pass
-        elif isinstance(state, (AgingLaw, SlipLaw, PRZLaw)) and state == type(state)():
-            object.__setattr__(self, "state_law", state.name)
+        if (not isinstance(self.state_law, str) and isinstance(state, (AgingLaw, SlipLaw, PRZLaw))
+                and state == type(state)()):
+            object.__setattr__(self, "state_law", state.name)  # a default law object: its name
         if isinstance(state, CallableStateLaw):
             rate_ss = state.rate(1.0, self.Dc, self.Dc)
             scale = max(abs(state.rate(1.0, 2.0 * self.Dc, self.Dc)), 1e-300)

@@ -90,6 +90,14 @@ class _Samples:
 # ======================================================================================
 # a = 0: stick, slide and slip
 # ======================================================================================
+def _charge(engine, nfev: int) -> None:
+    """Add ``nfev`` right-hand-side evaluations to ``engine``'s count; past the step budget
+    (``options.max_rhs_evals``) the run stops with ``STEP_BUDGET``."""
+    engine.nfev += nfev
+    if engine.nfev > engine.options.max_rhs_evals:
+        raise _Stop(Status.STEP_BUDGET, f"{engine.nfev} evaluations, at t = {engine.t:.10g}")
+
+
 class _PhaseEngine:
     """Event-driven integration of the a = 0 model (one phase per :meth:`step`)."""
 
@@ -311,11 +319,6 @@ class _PhaseEngine:
         self.next_out = max(self.next_out, j1)
         return out
 
-    def _count(self, nfev: int) -> None:
-        self.nfev += nfev
-        if self.nfev > self.options.max_rhs_evals:
-            raise _Stop(Status.STEP_BUDGET, f"{self.nfev} evaluations, at t = {self.t:.10g}")
-
     def _integrate_chunks(self, rhs, events, atol, out_times=None) -> OdeSolution:
         """CVODE over the slide in chunks of tau (CVODE ties its smallest step to the
         output time, so an open-ended output time is not an option).  ``out_times``
@@ -344,7 +347,7 @@ class _PhaseEngine:
                                 rtol=opts.rtol, atol=atol, method=opts.method,
                                 max_num_steps=opts.max_num_steps)
             nfev += sol.nfev
-            self._count(sol.nfev)
+            _charge(self, sol.nfev)
             if not sol.success:
                 t_fail = self.t + float(sol.y[-1][1]) if np.all(np.isfinite(sol.y[-1])) else self.t
                 raise _Stop(Status.SOLVER_FAILED, f"CVODE in a slide at t = {t_fail:.10g}: "
@@ -600,11 +603,6 @@ class _SmoothEngine:
                 self._record(self.y[None, :])
             self.next_out += 1
 
-    def _count(self, sol: OdeSolution) -> None:
-        self.nfev += sol.nfev
-        if self.nfev > self.options.max_rhs_evals:
-            raise _Stop(Status.STEP_BUDGET, f"{self.nfev} evaluations, at t = {self.t:.10g}")
-
     def _steady_exactly(self, lnV: float) -> bool:
         tol = 4.0 * np.finfo(float).eps * (1.0 + abs(lnV))
         if self.second is not None and abs(self.y[5] + lnV) > tol:
@@ -763,7 +761,7 @@ class _SmoothEngine:
         if self.at_root:
             # step off an event root without events (CVODE rejects a root at the start)
             sol = run(y_loc, 0.0, 1e-6, False)
-            self._count(sol)
+            _charge(self, sol.nfev)
             if not sol.success:
                 raise failed(sol)
             take_outputs(sol, 0)
@@ -776,7 +774,7 @@ class _SmoothEngine:
                 self._record(to_global(sol.y[1:]))
             if not sol.success:
                 raise failed(sol)
-            self._count(sol)
+            _charge(self, sol.nfev)
             for (_s, y_ev, idx, _sign) in sol.events:
                 if idx == 0 or (idx == 1 and not stop_on_min):
                     # a time series drops extrema at round-off distance from steady state;
