@@ -583,6 +583,18 @@ def rs_rhs(y, yp, p, c):
     rs_rhs_dr(y, yp, p, c, 0.0)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _state_rate(code, w, r, f, g):
+    r"""d ln(theta)/ds of a built-in state law (``code`` 0 aging, 1 slip, 2 PRZ; 3, Nagata,
+    gives its aging part) at :math:`w = \ln(v/v_s)`, :math:`r = \ln(v_s\theta/D_c)`, with
+    :math:`f = v_s/(v_s + v)`, :math:`g = 1 - f`."""
+    if code == 1.0:
+        return -g * (w + r)
+    if code == 2.0:
+        return 0.5 * (math.exp(-r) * f - g * math.exp(min(w + r, 700.0)))
+    return math.exp(-r) * f - g
+
+
 @njit(cache=True, nogil=True)
 def rs_rhs_dr(y, yp, p, c, dr_user):
     r"""Spring-slider with a direct effect :math:`a > 0`, optional radiation damping
@@ -635,25 +647,12 @@ def rs_rhs_dr(y, yp, p, c, dr_user):
     g = 1.0 - f                      # v / (vs + v)
     er = math.exp(-r)                # u / vs
     mu, wk = law_eval(vs * er, p)
-    if code == 0.0 or code == 3.0:
-        dr0 = er * f - g
-    elif code == 1.0:
-        dr0 = -g * (w + r)
-    elif code == 2.0:
-        dr0 = 0.5 * (er * f - g * math.exp(min(w + r, 700.0)))
-    else:
-        dr0 = dr_user
+    dr0 = dr_user if code == 4.0 else _state_rate(code, w, r, f, g)
     dq2 = 0.0
     mu2 = 0.0
     if b2 > 0.0:
         q2 = y[5]
-        ratio = c[15]
-        if code == 1.0:
-            dq2 = -ratio * g * (w + q2)
-        elif code == 2.0:
-            dq2 = ratio * 0.5 * (math.exp(-q2) * f - g * math.exp(min(w + q2, 700.0)))
-        else:
-            dq2 = ratio * (math.exp(-q2) * f - g)
+        dq2 = c[15] * _state_rate(code, w, q2, f, g)   # the same law, in units of Dc2
         mu2 = b2 * (q2 + c[16])
     stress = K * ((V / vs) * f - g)  # d(spring force)/ds
     damp = eta * vs * math.exp(min(w, 700.0)) if eta > 0.0 else 0.0   # eta v
