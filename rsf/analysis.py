@@ -32,6 +32,7 @@ from scipy.stats import linregress
 from ._validation import positive
 from .laws import HyperbolicLaw, LogLaw, SteadyStateLaw
 from .params import SolverOptions, SpringSlider
+from .state_laws import NAGATA, USER
 
 __all__ = ["CriticalVelocity", "critical_velocity", "HopfFit", "hopf_scaling", "fit_power_law",
            "steady_jacobian", "stability_margin"]
@@ -113,8 +114,6 @@ def steady_jacobian(model: SpringSlider, V: float) -> np.ndarray:
     user's function), and the first row becomes
     :math:`(-K - (W + a)p,\; -(W + a)q)/(a + \eta V)`.
     """
-    from .state_laws import NAGATA, USER
-
     V = positive("V", V)
     if model.a == 0.0:
         raise ValueError("steady_jacobian needs a direct effect a > 0")
@@ -179,8 +178,6 @@ def stability_margin(model: SpringSlider, V: float) -> float:
     PRZ laws and for :math:`a = 0`; the trace of the Jacobian for the Nagata and user laws
     when its determinant is positive (a saddle, determinant < 0, counts as unstable); the
     largest real part of the eigenvalues with a second state variable."""
-    from .state_laws import NAGATA, USER
-
     if model.second_state is not None:
         return float(np.max(np.linalg.eigvals(steady_jacobian(model, V)).real))
     if model.state.code in (NAGATA, USER) and model.a > 0.0:
@@ -215,7 +212,7 @@ def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: f
     if isinstance(law, SpringSlider):
         model = law
         if (model.eta_rad > 0.0 or model.second_state is not None
-                or (model.state.code in (3, 4) and model.a > 0.0)):
+                or (model.state.code in (NAGATA, USER) and model.a > 0.0)):
             return _critical_velocity_scan(model, v_min, v_max)
         law, k0, Dc = model.law, model.k0, model.Dc
     if law is None:
