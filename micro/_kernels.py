@@ -102,7 +102,8 @@ P_SHOCK = 15  # a step whose cascade shifts more bins than this is a shock
 P_REC_DSIGMA = 16  # record when the stress has moved this much
 P_S_MAX = 17  # largest landing displacement kappa z kept
 P_PULL_LAND = 18  # largest relaxation pull (bins) of mass landing between synchronisations
-N_PARAM = 19
+P_STOP_SHIFT = 19  # a cascade that has shifted this many bins stops the advance (STOP_EVENT), mid-cascade
+N_PARAM = 20
 
 # --- return codes ---------------------------------------------------------------------
 DONE = 0
@@ -467,7 +468,9 @@ def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, tol, ex_m, ex_y, e
     time, and goes on.  The remainder (below ``OWED_TOL``, possibly negative) is
     carried in ``F_OWED``, so ``sum(M * delta_F) + sigma - owed * eps`` is exactly
     constant.  Returns ``(total shift, iterations, code)``: ``code`` is DONE, or
-    NEED_ROWS / NEED_COLS when a landing did not fit the arrays (the exits wait in ``ex_*``).
+    NEED_ROWS / NEED_COLS when a landing did not fit the arrays (the exits wait in ``ex_*``),
+    or STOP_EVENT when the cascade has shifted ``P_STOP_SHIFT`` bins and still goes on (the
+    rest is owed in ``F_OWED``: the caller stops at the start of a global shock).
     """
     eps = prm[P_EPS]
     c_per_mass = (prm[P_K1] + prm[P_K2]) * prm[P_ZMEAN] / eps
@@ -499,7 +502,11 @@ def close_step(M, W, O, ist, fst, prm, table, chi, clo, owed, tol, ex_m, ex_y, e
             return total, it, NEED_ROWS if jumped > -1.5 else NEED_COLS
         if jumped > 0.0:
             owed += _apply_jumps(fst, prm, jumped, moment)
+        if total >= prm[P_STOP_SHIFT]:
+            break
     fst[F_OWED] = owed
+    if total >= prm[P_STOP_SHIFT] and owed > tol:
+        return total, it, STOP_EVENT
     return total, it, DONE
 
 

@@ -169,6 +169,10 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("sweep", help="stationary state for each drive velocity: one CSV row per V")
     _model_options(s)
     s.add_argument("--V", required=True, help="drive velocities, comma-separated, each in [1e-6, 1e7]")
+    s.add_argument("--method", choices=("auto", "fp", "cycle"), default="auto",
+                   help="auto: steady rows from the renewal chain, others by Fokker-Planck time-stepping (default); "
+                        "fp: time-step every row; cycle: stick-slip rows as the fixed point of the shock-to-shock map "
+                        "(small k0; default eps kappa*zbar/8; falls back to time-stepping where shocks are not total)")
     s.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,V,regime,sigma_max,sigma_min,sigma_mean,...")
 
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
@@ -236,7 +240,7 @@ def _run(args) -> int:
         velocities = _floats(args.V, "V", *V_RANGE)
         rows = []
         for i, V in enumerate(velocities):
-            res = stationary(models[0], V, numerics=numerics, convergence=convergence)
+            res = stationary(models[0], V, numerics=numerics, convergence=convergence, method=args.method)
             rows.append(res.to_dict())
             print(f"{_progress(i + 1, len(velocities), time.perf_counter() - start)} V={V:g}: {res.regime}, "
                   f"sigma_max={res.sigma_max:.6f}, sigma_min={res.sigma_min:.6f}"

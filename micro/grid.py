@@ -114,9 +114,15 @@ class Grid:
     """
 
     def __init__(self, model: Model, settings: GridSettings, initial: str = "frozen") -> None:
-        settings.check(model)
         if initial not in ("frozen", "relaxed", "uniform"):
             raise ValueError(f"initial must be 'frozen', 'relaxed' or 'uniform', got {initial!r}")
+        self._setup(model, settings)
+        self._build_initial(initial)
+        self._mean_delta_R()
+
+    def _setup(self, model: Model, settings: GridSettings) -> None:
+        """The constants of the kernels and the empty scalar state."""
+        settings.check(model)
         self.model = model
         self.settings = settings
         eps = settings.eps
@@ -142,10 +148,12 @@ class Grid:
         # jumping mass already had): bound it by the z that only 1e-12 of jumps exceed
         z_hi = float(np.asarray(model.jumps.quantile(np.array([1.0 - 1e-12])))[0])
         prm[K.P_PULL_LAND] = 2.0 * model.k2 * z_hi / eps
+        prm[K.P_STOP_SHIFT] = math.inf
         self.prm = prm
         self.ist = np.zeros(K.N_ISTATE, dtype=np.int64)
         self.fst = np.zeros(K.N_FSTATE)
-        self._build_initial(initial)
+
+    def _mean_delta_R(self) -> None:
         cells = self.cells()
         self.fst[K.F_YMEAN] = float(np.sum(cells["mass"] * cells["delta_R"]) / np.sum(cells["mass"]))
 
@@ -191,9 +199,59 @@ class Grid:
             y = np.zeros_like(delta)
         else:
             y = model.k2 / (model.k0 + model.k1) * (mean_delta - delta)
+        self._fill(delta, y, weight)
+
+    @classmethod
+    def from_points(cls, model: Model, settings: GridSettings, delta: np.ndarray, delta_R: np.ndarray,
+                    weight: np.ndarray) -> "Grid":
+        """A grid holding point masses ``weight`` at margins ``delta`` (>= 0) and dashpot
+        terms ``delta_R`` (normalised to total mass 1), each merged into its cell at the
+        centre of mass; time, drive position and mean position start at 0 and the stress
+        is ``f_th - <delta_F>`` of the cells."""
+        delta, delta_R, weight = (np.asarray(a, dtype=float).ravel() for a in (delta, delta_R, weight))
+        if not (delta.size == delta_R.size == weight.size and delta.size > 0):
+            raise ValueError("delta, delta_R and weight must be non-empty and of equal size")
+        if not (np.all(np.isfinite(delta)) and np.all(np.isfinite(delta_R)) and np.all(delta >= 0.0)
+                and np.all(weight >= 0.0) and weight.sum() > 0.0):
+            raise ValueError("delta must be finite and >= 0, delta_R finite, weight >= 0 with a positive sum")
+        keep = weight > 0.0
+        grid = object.__new__(cls)
+        grid._setup(model, settings)
+        grid._fill(delta[keep], delta_R[keep], weight[keep] / weight[keep].sum())
+        grid._mean_delta_R()
+        return grid
+
+    @classmethod
+    def from_cells(cls, model: Model, settings: GridSettings, j: np.ndarray, eta: np.ndarray, d: np.ndarray,
+                   weight: np.ndarray, omega: np.ndarray) -> "Grid":
+        """A grid from its cells: mass ``weight`` in the cell of delta_R bin ``j`` and delta
+        bin ``d``, at delta_R ``(j + eta) eps`` (``-0.5 <= eta < 0.5``), spread uniformly over
+        the upper fraction ``omega`` of the cell (its delta from ``(d + 1 + eta - omega) eps``
+        to ``(d + 1 + eta) eps``, which must be >= 0).  Normalised to total mass 1; the
+        stress is ``f_th - <delta_F>`` of the cells."""
+        j, d = (np.asarray(a, dtype=np.int64).ravel() for a in (j, d))
+        eta, weight, omega = (np.asarray(a, dtype=float).ravel() for a in (eta, weight, omega))
+        keep = weight > 0.0
+        if not (np.all(omega[keep] > 0.0) and np.all(omega[keep] <= 1.0) and np.all(np.abs(eta) <= 0.5)
+                and np.all(d[keep] + 1 + eta[keep] - omega[keep] >= -1e-9) and weight.sum() > 0.0):
+            raise ValueError("cells must have 0 < omega <= 1, |eta| <= 1/2, delta >= 0 and a positive mass")
+        grid = object.__new__(cls)
+        grid._setup(model, settings)
+        grid._fill_cells(j[keep], eta[keep], d[keep], weight[keep] / weight[keep].sum(), omega[keep])
+        grid._mean_delta_R()
+        return grid
+
+    def _fill(self, delta: np.ndarray, y: np.ndarray, weight: np.ndarray) -> None:
+        """Allocate the arrays and put the masses ``weight`` at (delta, delta_R = y)."""
+        eps = self.settings.eps
         j = np.floor(y / eps + 0.5).astype(np.int64)
         eta = y / eps - j
         d = np.floor(delta / eps - eta).astype(np.int64)
+        self._fill_cells(j, eta, d, weight, np.ones_like(weight))
+
+    def _fill_cells(self, j: np.ndarray, eta: np.ndarray, d: np.ndarray, weight: np.ndarray,
+                    omega: np.ndarray) -> None:
+        model, eps = self.model, self.settings.eps
         jbase = int(j.min()) - 4
         nrow = int(j.max()) - jbase + 5
         off = 3
@@ -205,7 +263,7 @@ class Grid:
         W = self.bufW[0]
         np.add.at(M, (r, c), weight)
         np.add.at(W, (r, c), weight * eta)
-        np.add.at(self.bufO[0], (r, c), weight)
+        np.add.at(self.bufO[0], (r, c), weight * omega)
         occupied = M > 0.0
         for row in range(nrow):
             cols = np.flatnonzero(occupied[row])
@@ -221,7 +279,7 @@ class Grid:
         ist[K.I_CUR] = 0
         # x (delta_F) centre of every cell, from its bin
         k = d - j
-        mean_x = float(np.sum(weight * (k + 0.5) * eps))
+        mean_x = float(np.sum(weight * (k + 1.0 - 0.5 * omega) * eps))
         fst[K.F_SUMX] = mean_x
         fst[K.F_MASS] = 1.0
         fst[K.F_SIGMA] = model.f_th - mean_x
@@ -389,6 +447,7 @@ class Grid:
         record_dt: float,
         stop_after_shocks: int = 0,
         shock_bins: float = 8.0,
+        stop_shift: float = math.inf,
         max_steps: int = 1 << 62,
     ) -> tuple[np.ndarray, np.ndarray, int]:
         """Advance to ``t_stop`` at constant drive velocity.
@@ -397,9 +456,12 @@ class Grid:
         record) are written whenever the stress has moved by ``record_dsigma``, after at
         most ``record_dt``, and just before and after every shock.  Shocks (rows
         ``t, sigma_before, sigma_after, shift``) are the steps whose cascade shifted delta_F
-        by more than ``shock_bins`` bins.  Returns ``(records, shocks, code)``.
+        by more than ``shock_bins`` bins.  A cascade that has shifted ``stop_shift`` bins
+        and goes on stops the advance there, mid-cascade, with code ``STOP_EVENT`` (the
+        rest of its shift is owed).  Returns ``(records, shocks, code)``.
         """
         self.prm[K.P_SHOCK] = shock_bins
+        self.prm[K.P_STOP_SHIFT] = stop_shift
         self.prm[K.P_REC_DSIGMA] = record_dsigma
         records: list[np.ndarray] = []
         shocks: list[np.ndarray] = []

@@ -23,8 +23,9 @@ from scipy.stats import linregress
 from . import _kernels as K
 from .analysis import Records, cycle_converged, find_cycles
 from .analytic import sigma_fast_limit
+from .cycle import cycle_fixed_point
 from .grid import Grid, GridSettings
-from .params import Model
+from .params import KIND_EXPONENTIAL, Model
 from .protocols import Drive
 from .renewal import critical_velocity_renewal, steady_sliding
 
@@ -377,6 +378,41 @@ def _drive_position(drive: Drive, t: float) -> float:
 
 
 # ------------------------------------------------------------------------------ stationary
+#: The methods of :func:`stationary` and :func:`sweep`.
+METHODS = ("auto", "fp", "cycle")
+#: Default bin of ``method="cycle"``, in units of a mean jump kappa * zbar.
+CYCLE_EPS_FRACTION = 1.0 / 8.0
+
+
+def _cycle(model: Model, V: float, numerics: Numerics, convergence: Convergence, warn: bool) -> Stationary:
+    """``stationary(method="cycle")``: steady rows from the renewal chain, stick-slip rows
+    from the fixed point of the shock-to-shock map (:mod:`micro.cycle`), and the
+    Fokker-Planck time-stepping where that map does not apply (shocks that are not total,
+    jumps that are not exponential)."""
+    direct = _direct_steady(model, V)
+    if direct is not None:
+        return direct
+    eps = numerics.eps if numerics.eps is not None else model.kappa * model.zbar * CYCLE_EPS_FRACTION
+    tol = convergence.rtol * (model.f_th - sigma_fast_limit(model)) + convergence.atol
+    fallback = "jumps are not exponential"
+    if model.jumps.kind == KIND_EXPONENTIAL:
+        res = cycle_fixed_point(model, V, eps, tol=tol, theta_shift=numerics.theta_shift,
+                                theta_relax=numerics.theta_relax)
+        if res.applicable:
+            if not res.converged and warn:
+                log.warning("micro.stationary(k0=%g, V=%g, method='cycle'): %s", model.k0, V, res.message)
+            return Stationary(
+                model=model, V=V, eps=eps, regime="stick-slip", sigma_max=res.sigma_max, sigma_min=res.sigma_min,
+                sigma_mean=res.sigma_mean, period=res.period, converged=res.converged, message=res.message,
+                t_end=float(np.nansum(res.history[:, 2])) if res.history is not None else math.nan,
+                n_cycles=res.iterations, wall_time=res.wall_time, sigma_stderr=res.error, shocks_per_cycle=1.0,
+                mass_error=res.mass_error, min_mass=res.min_mass)
+        fallback = res.message
+    out = stationary(model, V, numerics=replace(numerics, eps=eps), convergence=convergence, warn=warn, method="fp")
+    out.message = f"cycle method not applicable ({fallback}): Fokker-Planck time-stepping; {out.message}"
+    return out
+
+
 def _direct_steady(model: Model, V: float) -> Stationary | None:
     """The steady state from the renewal chain if steady sliding is stable at V, else None."""
     start = time.perf_counter()
@@ -407,6 +443,18 @@ def stationary(
 ) -> Stationary:
     """The attractor at constant drive velocity ``V``: a steady stress or a stick-slip cycle.
 
+    ``method="cycle"``: where steady sliding is unstable, the stick-slip cycle is the
+    fixed point of its shock-to-shock return map (:func:`micro.cycle.cycle_fixed_point`):
+    the state after a total global shock is Exp(kappa zbar) in delta times the marginal
+    of delta_R, the Fokker-Planck grid carries it through one loading phase, and the
+    shock is solved in closed form, so no shock is time-stepped and the cost per cycle
+    does not grow as k0 falls (k0 = 1e-3 and 1e-4 cost what k0 = 0.01 does).  It stops
+    when ``n = 8`` cycles show no drift and their mean is known to ``rtol * (f_th -
+    sigma_fast_limit(model)) + atol`` (``sigma_stderr`` holds that error; 1e-3 with the
+    defaults); the default bin is ``kappa * zbar / 8``.  Where shocks are not total (large
+    k0, or close to V^c) or jumps are not exponential, it falls back to time-stepping
+    and says so in ``message``.
+
     ``method="auto"`` (the default) asks the renewal chain first
     (:func:`micro.steady_sliding`): where steady sliding is stable its stress is exact
     (to ~1e-11, in milliseconds) and no time-stepping is done; elsewhere, and whenever
@@ -427,10 +475,12 @@ def stationary(
     :func:`critical_velocity`); ``converged`` and ``message`` say it either way.
     """
     V = _check_velocity(V)
-    if method not in ("auto", "fp"):
-        raise ValueError(f"method must be 'auto' or 'fp', got {method!r}")
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(repr(m) for m in METHODS)}, got {method!r}")
     numerics = numerics or Numerics()
     convergence = convergence or Convergence()
+    if method == "cycle":
+        return _cycle(model, V, numerics, convergence, warn)
     settings = numerics.settings(model)
     wants_fp_state = keep_grid or keep_records or not (isinstance(initial, str) and initial == "auto")
     if method == "auto" and not wants_fp_state:
@@ -871,16 +921,20 @@ def sweep(
 
     With ``method="auto"`` a velocity where steady sliding is stable takes its row from
     the renewal chain (no time-stepping); the others are Fokker-Planck runs
-    (``method="fp"``: all of them).  With ``continuation`` every Fokker-Planck run starts
+    (``method="fp"``: all of them).  ``method="cycle"``: stick-slip rows from the
+    return map's fixed point (see :func:`stationary`).  With ``continuation`` every Fokker-Planck run starts
     from the previous run's final density (points are visited in the given order),
     which shortens transients.
     """
-    if method not in ("auto", "fp"):
-        raise ValueError(f"method must be 'auto' or 'fp', got {method!r}")
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(repr(m) for m in METHODS)}, got {method!r}")
     velocities = [_check_velocity(V) for V in velocities]
     rows = []
     grid = None
     for V in velocities:
+        if method == "cycle":
+            rows.append(stationary(model, V, numerics=numerics, convergence=convergence, method="cycle").to_dict())
+            continue
         direct = _direct_steady(model, V) if method == "auto" else None
         if direct is not None:
             rows.append(direct.to_dict())
