@@ -2,7 +2,7 @@
 against the Fokker-Planck time-stepping (``method="fp"``), run time and values (issue 16).
 
 Points: the Fig. 4 parameters at V = 0.3 V^c for k0 = 0.01, 1e-3, 1e-4 (V^c from the
-renewal chain), bins eps = kappa zbar / {6, 8, 12}.  Both methods solve the same
+renewal chain), bins eps = kappa zbar / {6, 8}.  Both methods solve the same
 discretised equation, so at equal eps they must agree within their errors; the
 exact sigma_min = ``micro.sigma_fast_limit`` (docs/reference/micro_model.md §5) checks
 both.  The time-stepping is run only where it costs less than ``--fp-budget`` seconds
@@ -10,7 +10,7 @@ per point (its shocks are time-stepped: ~0.5 s per cycle at k0 = 1e-3, growing a
 
 Writes benchmarks/results/micro_cycle_speed.csv.
 
-    python benchmarks/micro_cycle_speed.py          # about 10 minutes
+    python benchmarks/micro_cycle_speed.py          # about 5 minutes
 """
 from __future__ import annotations
 
@@ -29,7 +29,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--k0", default="0.01,0.001,0.0001")
     ap.add_argument("--frac", type=float, default=0.3, help="V / V^c")
-    ap.add_argument("--divisors", default="6,8,12", help="eps = kappa zbar / divisor")
+    ap.add_argument("--divisors", default="6,8", help="eps = kappa zbar / divisor")
     ap.add_argument("--rtol", type=float, default=1e-3)
     ap.add_argument("--fp-k0-min", type=float, default=1e-3, help="time-step only at k0 >= this")
     args = ap.parse_args()

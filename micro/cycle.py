@@ -9,15 +9,28 @@ block that jumped leaves with a margin delta ~ Exp(kappa zbar), independent of t
 
 .. math:: P(\delta, \delta_R) = \frac{e^{-\delta/\kappa\bar z}}{\kappa\bar z}\, p(\delta_R),
 
-and one cycle is a map :math:`p \mapsto \Phi(p)` of the 1-D marginal of delta_R alone:
-the Fokker-Planck equation (:mod:`micro.grid`) carries the product state through the
-loading phase, stops at the start of the next shock, and the shock itself is solved in
-closed form (:func:`_shock`).  The limit cycle is the fixed point :math:`p = \Phi(p)`,
-found by Anderson acceleration instead of 20-100 transient cycles (the marginal relaxes
-by about :math:`k_2/\kappa` per cycle: a block's lag is reset by each shock only through
-``k2 u``).  ``sigma_max`` is the stress at the start of the shock, ``sigma_min`` the
+and one cycle is a map :math:`p \mapsto \Phi(p)` of the 1-D marginal of delta_R alone
+(kept as masses on nodes of spacing eps, each atom shared linearly between its two
+nodes).  The Fokker-Planck equation (:mod:`micro.grid`) carries the product state
+through the loading phase; the step in which the next shock starts is replayed in steps
+``FINE`` times shorter, so that where the shock starts does not depend on where the
+loading's steps fell; the kernel stops ``SHOCK_BINS`` bins into the shock, where every
+delta_R still has its value (jumps keep u), and that marginal is the image.  The shock
+itself is never time-stepped: its extent, solved in closed form (:func:`_shock`), only
+tells whether it was total.  So a cycle costs the same at k0 = 1e-4 as at k0 = 0.01,
+where time-stepping pays for a shock of ~0.06 / k0 mean jumps in every cycle.
+
+The limit cycle is the fixed point :math:`p = \Phi(p)`.  It is found by iterating the
+map from the first shock's image: the marginal relaxes by about 0.8 per cycle (a
+block's lag survives a shock only through ``k2 u``, a factor ~ k2/kappa, and the
+variance decays as its square), so 20-30 cycles are needed.  Anderson acceleration
+was tried and stalls: the map is continuous only to the grid's resolution (where a
+near-critical avalanche closes or runs away depends on single cells: jumps of
+sigma_max of ~k0 eps, 1e-4 at k0 = 0.01, eps = 0.016, measured), which extrapolation
+amplifies.  ``sigma_max`` is the stress at the start of the shock, ``sigma_min`` the
 stress of the product state (``micro.sigma_fast_limit`` when every dashpot term averages
-to 0, as at the fixed point), the period the loading time.
+to 0, as at the fixed point, to the cells' eps^2 / (12 kappa zbar)), the period the
+loading time.
 
 The shock in closed form: a block of margin delta jumps once the common shift s reaches
 delta, and then as a Poisson process of rate 1/(kappa zbar) in s, so the shift closes
@@ -25,7 +38,7 @@ at the first root of
 
 .. math:: F(s) = s_0 + (k_1+k_2)\bar z\, E\left[1_{\delta<s}\left(1 + \frac{s-\delta}{\kappa\bar z}\right)\right] - s,
 
-with :math:`s_0` the shift still owed when the kernel stopped.
+with :math:`s_0` the shift still owed (the kernel's SHOCK_BINS bins).
 """
 from __future__ import annotations
 
@@ -48,6 +61,10 @@ log = logging.getLogger(__name__)
 SHOCK_BINS = 8.0
 #: Largest mass a shock may leave unjumped for the product form to hold.
 UNJUMPED_TOL = 1e-10
+#: The loading runs in chunks of this many steps (a copy of the grid is kept at each
+#: chunk's start); the step in which a shock starts is replayed in steps FINE times shorter.
+CHUNK = 32
+FINE = 64
 #: Row masses below this are dropped from an iterate (Anderson's extrapolation leaves
 #: round-off in rows the density never reaches).
 MASS_FLOOR = 1e-15
@@ -157,25 +174,55 @@ class _Map:
         rows = np.flatnonzero(x > 0.0)
         grid = _product_grid(self.model, self.settings, rows + self.j_lo, x[rows], np.zeros(rows.size))
         sigma_start = grid.sigma
-        rec, shocks, code = grid.advance(self.V, self.t_max, record_dsigma=math.inf, record_dt=0.0,
-                                         shock_bins=SHOCK_BINS, stop_shift=SHOCK_BINS + 1e-9)
-        if code != K.STOP_EVENT or len(rec) < 3:
-            return dict(ok=False, message=f"no global shock by t = {grid.t:.4g} (kernel code {code})")
-        # the shock starts: the kernel stopped it 8 bins in, where every delta_R still has
-        # its value from before it (jumps keep u); its extent in closed form tells whether
-        # it is total (then the state after it is the product of Exp and this marginal)
-        cells = grid.cells()
-        s, unjumped = _shock(cells, float(grid.fst[K.F_OWED]) * self.settings.eps, self.model)
-        x_new, outside = _rows(cells["delta_R"], cells["mass"], self.settings.eps, self.j_lo, x.size)
-        # the shock starts somewhere within its step: sigma_max is known to the drive of one step
+        # load in chunks of CHUNK steps; when a chunk starts the shock, replay it from its
+        # start to the step before, and that step in steps FINE times shorter: the shock
+        # then starts within a drive of theta_shift / FINE bins of where a continuous
+        # drive would start it (a step's cascade runs past SHOCK_BINS only once the
+        # branching ratio at the threshold exceeds 1 - drive / SHOCK_BINS)
+        self._integral = 0.0
+        while True:
+            t0, start = grid.t, grid.copy()
+            rec, shocks, code = self._advance(grid, self.t_max, max_steps=CHUNK)
+            if not len(shocks):
+                self._integral += _time_integral(rec, t0)
+                if code == K.MAX_STEPS:
+                    continue
+                return dict(ok=False, message=f"no global shock by t = {grid.t:.4g} (kernel code {code})")
+            t_shock = float(shocks[0, 0])
+            ends = np.unique(rec[rec[:, 0] < t_shock, 0])  # every step writes one record
+            grid = start
+            if ends.size:
+                rec, _, _ = self._advance(grid, float(ends[-1]), max_steps=ends.size)
+                self._integral += _time_integral(rec, t0)
+            t1 = grid.t
+            grid.prm[K.P_THETA_S] = self.settings.theta_shift / FINE
+            rec, shocks, code = self._advance(grid, self.t_max)
+            if not len(shocks):
+                return dict(ok=False, message=f"the shock did not repeat in the finer steps (kernel code {code})")
+            self._integral += _time_integral(rec[rec[:, 0] < grid.t], t1)
+            break
         earlier = rec[rec[:, 0] < grid.t]
-        t_rows = np.concatenate(([0.0], earlier[:, 0]))
-        sigma_mean = float(np.sum(earlier[:, 4] * np.diff(t_rows)) / t_rows[-1])
-        quantum = self.model.k0 * self.V * (grid.t - float(earlier[-1, 0]))
-        return dict(ok=True, x=x_new, outside=outside, sigma_max=float(shocks[0, 1]), sigma_min=sigma_start,
-                    quantum=quantum, sigma_mean=sigma_mean, mass_error=abs(grid.mass() - 1.0),
-                    min_mass=min(grid.min_mass(), 0.0),
-                    period=grid.t, shift=s, unjumped=unjumped, mean_delta_R=float(grid.fst[K.F_YMEAN]))
+        quantum = self.model.k0 * self.V * (grid.t - (float(earlier[-1, 0]) if len(earlier) else t1))
+        sigma_max = float(shocks[0, 1])
+        cells = grid.cells()
+        s, unjumped = _shock(cells, SHOCK_BINS * self.settings.eps, self.model)
+        x_new, outside = _rows(cells["delta_R"], cells["mass"], self.settings.eps, self.j_lo, x.size)
+        return dict(ok=True, x=x_new, outside=outside, sigma_max=sigma_max, sigma_min=sigma_start,
+                    period=grid.t, sigma_mean=self._integral / grid.t, shift=s, unjumped=unjumped, quantum=quantum,
+                    mass_error=abs(grid.mass() - 1.0), min_mass=min(grid.min_mass(), 0.0))
+
+    def _advance(self, grid: Grid, t_stop: float, max_steps: int = 1 << 62) -> tuple[np.ndarray, np.ndarray, int]:
+        """Advance with a record at every step, stopping SHOCK_BINS into a shock."""
+        return grid.advance(self.V, t_stop, record_dsigma=math.inf, record_dt=0.0, shock_bins=SHOCK_BINS,
+                            stop_shift=SHOCK_BINS + 1e-9, max_steps=max_steps)
+
+
+def _time_integral(rec: np.ndarray, t0: float) -> float:
+    """Time integral of the stress over records written at every step since ``t0``
+    (each row's last column is the mean since the previous row)."""
+    if len(rec) == 0:
+        return 0.0
+    return float(np.sum(rec[:, 4] * np.diff(np.concatenate(([t0], rec[:, 0])))))
 
 
 def _wasserstein(a: np.ndarray, b: np.ndarray, eps: float) -> float:
@@ -202,16 +249,14 @@ def cycle_fixed_point(model: Model, V: float, eps: float, *, tol: float = 1e-5, 
     point of the shock-to-shock return map (module docstring), by iterating the map.
 
     Each evaluation is one loading phase on the Fokker-Planck grid, and no shock is
-    time-stepped, so the cost per cycle does not grow as k0 falls.  The grid's shock
-    starts in a whole time step, so near the fixed point sigma_max jitters by up to
-    ~k0 V dt from cycle to cycle (as in the time-stepping) and the map cannot be solved
-    by Newton or Anderson steps (tried: they stall at that jitter).  The iteration stops
+    time-stepped, so the cost per cycle does not grow as k0 falls.  The iteration stops
     when the last ``n`` cycles show no significant drift (fitted slope times ``n`` below
     twice its standard error plus ``tol / 4``) and the error is below ``tol``; the
     result is their mean.  The error is the standard error of that mean combined with
-    the drift, and at least half the stress the drive adds in the step in which the
-    shock starts (where in that step it starts is not resolved).  At
-    most ``max_iter`` evaluations.  ``start`` (a result at another eps or V) seeds the marginal.
+    the drift, plus half the stress the drive adds in one of the finer steps in which
+    the shock's start is found.  It is the error of the fixed point at this eps, not
+    the discretisation error of eps.  At most ``max_iter`` evaluations.  ``start`` (a
+    result at another eps or V) seeds the marginal.
     Needs exponential jumps and total shocks; otherwise the result says so
     (``converged=False``) and :func:`micro.stationary`'s time-stepping applies.
     """
@@ -262,17 +307,13 @@ def cycle_fixed_point(model: Model, V: float, eps: float, *, tol: float = 1e-5, 
         if len(hist) >= n:
             mean, sem, drift, drift_err = _window(np.array(hist)[:, :2], n)
             settled = bool(np.all(drift <= 2.0 * drift_err + 0.25 * tol))
-            spread = float(np.max(np.hypot(sem, drift)))
-            error = max(spread, 0.5 * out["quantum"])
+            # (the shock's start is resolved to the drive of one of the finer steps)
+            error = float(np.max(np.hypot(sem, drift))) + 0.5 * out["quantum"]
             # converged: no significant drift over the window and a small enough error
             if settled and error <= tol:
                 converged = True
                 message = (f"limit cycle of the return map: the last {n} cycles (of {it}) agree, sigma_max and "
                            f"sigma_min to {error:.1e} (standard error, drift, half a step's drive)")
-                break
-            if settled and spread <= tol:  # more cycles cannot help
-                message = (f"the limit cycle settled, but the shock's start is resolved only to half a step's "
-                           f"drive, {0.5 * out['quantum']:.1e} > tol = {tol:.2g}: use a smaller theta_shift or eps")
                 break
     else:
         message = f"no fixed point to {tol:g} in {max_iter} cycles (error estimate {error:.2g})"
