@@ -65,8 +65,8 @@ UNJUMPED_TOL = 1e-10
 #: chunk's start); the step in which a shock starts is replayed in steps FINE times shorter.
 CHUNK = 32
 FINE = 64
-#: Row masses below this are dropped from an iterate (Anderson's extrapolation leaves
-#: round-off in rows the density never reaches).
+#: Node masses below this are dropped from an iterate (round-off in nodes the density
+#: never reaches would otherwise widen the grid).
 MASS_FLOOR = 1e-15
 #: Tail mass of Exp(kappa zbar) dropped beyond the last cell.
 EXP_TAIL = 1e-16
@@ -77,11 +77,12 @@ class CycleFixedPoint:
     """The limit cycle at one bin ``eps``: extrema, period, and how the iteration ended.
 
     ``error`` estimates the distance of sigma_max and sigma_min from the fixed point at
-    this eps, including half a time step's drive (not the discretisation error of eps), ``unjumped`` is the mass the last shock left
-    unjumped (the product form needs it below ``UNJUMPED_TOL``), ``applicable`` is False
-    when a loading phase ended without a global shock or a shock was not total (the map
-    does not describe such cycles), ``history`` the rows
-    (sigma_max, sigma_min, period, sigma_mean) of every cycle, ``p`` the delta_R marginal (nodes, masses).
+    this eps, including half a fine step's drive (it is not the discretisation error of
+    eps); ``unjumped`` is the mass the last shock left unjumped (the product form needs
+    it below ``UNJUMPED_TOL``); ``applicable`` is False when a loading phase ended
+    without a global shock or a shock was not total (the map does not describe such
+    cycles); ``history`` holds the rows (sigma_max, sigma_min, period, sigma_mean) of
+    every cycle, ``p`` the delta_R marginal (nodes, masses).
     """
 
     model: Model
@@ -225,12 +226,6 @@ def _time_integral(rec: np.ndarray, t0: float) -> float:
     return float(np.sum(rec[:, 4] * np.diff(np.concatenate(([t0], rec[:, 0])))))
 
 
-def _wasserstein(a: np.ndarray, b: np.ndarray, eps: float) -> float:
-    """The L1 distance of the cumulative node masses times the node spacing (the
-    Wasserstein-1 distance of the two marginals, in units of delta_R)."""
-    return float(np.abs(np.cumsum(a - b)).sum() * eps)
-
-
 def _initial_marginal(model: Model, eps: float, j_lo: int, n_rows: int) -> np.ndarray:
     """A start: every dashpot relaxed to the lag of an Exp(kappa zbar) margin, the
     marginal of ``(k2 / kappa) (<delta> - delta)`` (the first shock's image)."""
@@ -282,7 +277,7 @@ def cycle_fixed_point(model: Model, V: float, eps: float, *, tol: float = 1e-5, 
     # a loading phase raises the stress from about f_th - kappa zbar to below f_th at a
     # rate that creep lowers from k0 V: allow 20 times kappa zbar / (k0 V)
     phi = _Map(model, settings, V, t_max=20.0 * lam / (model.k0 * V), j_lo=j_lo)
-    hist: list[tuple[float, float, float]] = []
+    hist: list[tuple[float, float, float, float]] = []
     out: dict = {}
     error = math.nan
     converged, message, applicable = False, "", True
@@ -313,7 +308,7 @@ def cycle_fixed_point(model: Model, V: float, eps: float, *, tol: float = 1e-5, 
             if settled and error <= tol:
                 converged = True
                 message = (f"limit cycle of the return map: the last {n} cycles (of {it}) agree, sigma_max and "
-                           f"sigma_min to {error:.1e} (standard error, drift, half a step's drive)")
+                           f"sigma_min to {error:.1e} (standard error, drift, half a fine step's drive)")
                 break
     else:
         message = f"no fixed point to {tol:g} in {max_iter} cycles (error estimate {error:.2g})"
@@ -332,7 +327,7 @@ def cycle_fixed_point(model: Model, V: float, eps: float, *, tol: float = 1e-5, 
     return res
 
 
-def _window(values: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _window(values: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Over the last ``n`` rows of ``values`` (one column per quantity): the means, their
     standard errors, and the drift (fitted slope times n) with its standard error."""
     w = values[-n:]
