@@ -38,7 +38,7 @@ at the first root of
 
 .. math:: F(s) = s_0 + (k_1+k_2)\bar z\, E\left[1_{\delta<s}\left(1 + \frac{s-\delta}{\kappa\bar z}\right)\right] - s,
 
-with :math:`s_0` the shift still owed (the kernel's SHOCK_BINS bins).
+with :math:`s_0` the shift the kernel still owes where it stopped, SHOCK_BINS bins into the shock.
 """
 from __future__ import annotations
 
@@ -59,8 +59,10 @@ log = logging.getLogger(__name__)
 
 #: A cascade that shifts more than this many bins is a global shock (as in ``stationary``).
 SHOCK_BINS = 8.0
-#: Largest mass a shock may leave unjumped for the product form to hold.
-UNJUMPED_TOL = 1e-10
+#: Largest mass a shock may leave unjumped for the product form to hold: that mass keeps
+#: a margin of order 1 instead of Exp(kappa zbar), so the stress after the shock is off
+#: by less than about this.
+UNJUMPED_TOL = 1e-6
 #: The loading runs in chunks of this many steps (a copy of the grid is kept at each
 #: chunk's start); the step in which a shock starts is replayed in steps FINE times shorter.
 CHUNK = 32
@@ -206,7 +208,7 @@ class _Map:
         quantum = self.model.k0 * self.V * (grid.t - (float(earlier[-1, 0]) if len(earlier) else t1))
         sigma_max = float(shocks[0, 1])
         cells = grid.cells()
-        s, unjumped = _shock(cells, SHOCK_BINS * self.settings.eps, self.model)
+        s, unjumped = _shock(cells, float(grid.fst[K.F_OWED]) * self.settings.eps, self.model)
         x_new, outside = _rows(cells["delta_R"], cells["mass"], self.settings.eps, self.j_lo, x.size)
         return dict(ok=True, x=x_new, outside=outside, sigma_max=sigma_max, sigma_min=sigma_start,
                     period=grid.t, sigma_mean=self._integral / grid.t, shift=s, unjumped=unjumped, quantum=quantum,
@@ -238,7 +240,7 @@ def _initial_marginal(model: Model, eps: float, j_lo: int, n_rows: int) -> np.nd
 
 
 def cycle_fixed_point(model: Model, V: float, eps: float, *, tol: float = 1e-5, max_iter: int = 200,
-                      n: int = 8, start: CycleFixedPoint | None = None, theta_shift: float = 0.5,
+                      n: int = 10, start: CycleFixedPoint | None = None, theta_shift: float = 0.5,
                       theta_relax: float = 0.5) -> CycleFixedPoint:
     """The stick-slip limit cycle at drive velocity ``V`` and bin ``eps`` as the fixed
     point of the shock-to-shock return map (module docstring), by iterating the map.

@@ -449,7 +449,7 @@ def stationary(
     of delta_R, the Fokker-Planck grid carries it through one loading phase, and the
     shock is solved in closed form, so no shock is time-stepped and the cost per cycle
     does not grow as k0 falls (k0 = 1e-3 and 1e-4 cost what k0 = 0.01 does).  It stops
-    when ``n = 8`` cycles show no drift and their mean is known to ``rtol * (f_th -
+    when ``n = 10`` cycles show no drift and their mean is known to ``rtol * (f_th -
     sigma_fast_limit(model)) + atol`` (``sigma_stderr`` holds that error; 1e-3 with the
     defaults); the default bin is ``kappa * zbar / 8``.  Where shocks are not total (large
     k0, or close to V^c) or jumps are not exponential, it falls back to time-stepping

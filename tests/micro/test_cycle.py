@@ -139,3 +139,16 @@ def test_cli_sweep_method_cycle(tmp_path):
     assert abs(row.sigma_min - micro.sigma_fast_limit(micro.Model(k0=0.001))) < 1.5 * 0.025**2 / (12 * 0.1001)
     assert row.sigma_max > row.sigma_mean > row.sigma_min and row.period > 0
     assert {"sigma_stderr", "eps", "n_cycles", "message"} <= set(row.index)
+
+
+def test_cycle_declines_shocks_that_are_not_total_near_vc():
+    """Close to V^c at k0 = 0.01 the stress drop is ~0.005, a shift of (k1 + k2) 0.005 / k0
+    ~ 5 kappa zbar: about e^-5 of the blocks are not reached, and the map must say so
+    (the closed-form shock from the kernel's state, with the shift it still owes)
+    instead of returning a cycle; at 0.9 V^c the shift is ~25 kappa zbar and it is total."""
+    vc = float(micro.critical_velocity(MODEL).Vc)
+    near = cycle_fixed_point(MODEL, 0.99 * vc, 0.0125, tol=1e-4)
+    assert not near.applicable and not near.converged and "not a total shock" in near.message
+    far = cycle_fixed_point(MODEL, 0.9 * vc, 0.0125, tol=1e-4)
+    assert far.applicable and far.converged and far.unjumped < 1e-6
+    assert 0.02 < far.sigma_max - far.sigma_min < 0.03
