@@ -202,26 +202,6 @@ class Grid:
         self._fill(delta, y, weight)
 
     @classmethod
-    def from_points(cls, model: Model, settings: GridSettings, delta: np.ndarray, delta_R: np.ndarray,
-                    weight: np.ndarray) -> "Grid":
-        """A grid holding point masses ``weight`` at margins ``delta`` (>= 0) and dashpot
-        terms ``delta_R`` (normalised to total mass 1), each merged into its cell at the
-        centre of mass; time, drive position and mean position start at 0 and the stress
-        is ``f_th - <delta_F>`` of the cells."""
-        delta, delta_R, weight = (np.asarray(a, dtype=float).ravel() for a in (delta, delta_R, weight))
-        if not (delta.size == delta_R.size == weight.size and delta.size > 0):
-            raise ValueError("delta, delta_R and weight must be non-empty and of equal size")
-        if not (np.all(np.isfinite(delta)) and np.all(np.isfinite(delta_R)) and np.all(delta >= 0.0)
-                and np.all(weight >= 0.0) and weight.sum() > 0.0):
-            raise ValueError("delta must be finite and >= 0, delta_R finite, weight >= 0 with a positive sum")
-        keep = weight > 0.0
-        grid = object.__new__(cls)
-        grid._setup(model, settings)
-        grid._fill(delta[keep], delta_R[keep], weight[keep] / weight[keep].sum())
-        grid._mean_delta_R()
-        return grid
-
-    @classmethod
     def from_cells(cls, model: Model, settings: GridSettings, j: np.ndarray, eta: np.ndarray, d: np.ndarray,
                    weight: np.ndarray, omega: np.ndarray) -> "Grid":
         """A grid from its cells: mass ``weight`` in the cell of delta_R bin ``j`` and delta
