@@ -239,8 +239,12 @@ def _run(args) -> int:
     if args.command == "sweep":
         velocities = _floats(args.V, "V", *V_RANGE)
         rows = []
+        seed = "auto"  # with --method cycle, each row starts from the previous row's fixed point
         for i, V in enumerate(velocities):
-            res = stationary(models[0], V, numerics=numerics, convergence=convergence, method=args.method)
+            res = stationary(models[0], V, numerics=numerics, convergence=convergence, method=args.method,
+                             initial=seed)
+            if res.cycle is not None and res.cycle.applicable:
+                seed = res.cycle
             rows.append(res.to_dict())
             print(f"{_progress(i + 1, len(velocities), time.perf_counter() - start)} V={V:g}: {res.regime}, "
                   f"sigma_max={res.sigma_max:.6f}, sigma_min={res.sigma_min:.6f}"
