@@ -202,9 +202,9 @@ class _Map:
             rec, shocks, code = self._advance(grid, self.t_max)
             if not len(shocks):
                 return dict(ok=False, message=f"the shock did not repeat in the finer steps (kernel code {code})")
-            self._integral += _time_integral(rec[rec[:, 0] < grid.t], t1)
+            earlier = rec[rec[:, 0] < grid.t]  # the fine steps before the one the shock starts in
+            self._integral += _time_integral(earlier, t1)
             break
-        earlier = rec[rec[:, 0] < grid.t]
         quantum = self.model.k0 * self.V * (grid.t - (float(earlier[-1, 0]) if len(earlier) else t1))
         sigma_max = float(shocks[0, 1])
         cells = grid.cells()
