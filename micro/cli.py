@@ -169,10 +169,11 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("sweep", help="stationary state for each drive velocity: one CSV row per V")
     _model_options(s)
     s.add_argument("--V", required=True, help="drive velocities, comma-separated, each in [1e-6, 1e7]")
-    s.add_argument("--method", choices=("auto", "fp", "cycle"), default="auto",
+    s.add_argument("--method", choices=("auto", "fp", "cycle", "cohort"), default="auto",
                    help="auto: steady rows from the renewal chain, others by Fokker-Planck time-stepping (default); "
                         "fp: time-step every row; cycle: stick-slip rows as the fixed point of the shock-to-shock map "
-                        "(small k0; default eps kappa*zbar/8; falls back to time-stepping where shocks are not total)")
+                        "(small k0; default eps kappa*zbar/8); cohort: stick-slip rows by the grid-free cohort method "
+                        "(default delta_R cell kappa*zbar/20); both fall back to time-stepping where shocks are not total")
     s.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,V,regime,sigma_max,sigma_min,sigma_mean,...")
 
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
@@ -239,7 +240,7 @@ def _run(args) -> int:
     if args.command == "sweep":
         velocities = _floats(args.V, "V", *V_RANGE)
         rows = []
-        seed = "auto"  # with --method cycle, each row starts from the previous row's fixed point
+        seed = "auto"  # with --method cycle or cohort, each row starts from the previous row's fixed point
         for i, V in enumerate(velocities):
             res = stationary(models[0], V, numerics=numerics, convergence=convergence, method=args.method,
                              initial=seed)

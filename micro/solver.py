@@ -23,6 +23,7 @@ from scipy.stats import linregress
 from . import _kernels as K
 from .analysis import Records, cycle_converged, find_cycles
 from .analytic import sigma_fast_limit
+from .cohort import cycle_cohorts
 from .cycle import CycleFixedPoint, cycle_fixed_point
 from .grid import Grid, GridSettings
 from .params import KIND_EXPONENTIAL, Model
@@ -380,29 +381,36 @@ def _drive_position(drive: Drive, t: float) -> float:
 
 # ------------------------------------------------------------------------------ stationary
 #: The methods of :func:`stationary` and :func:`sweep`.
-METHODS = ("auto", "fp", "cycle")
+METHODS = ("auto", "fp", "cycle", "cohort")
 #: Default bin of ``method="cycle"``, in units of a mean jump kappa * zbar.
 CYCLE_EPS_FRACTION = 1.0 / 8.0
 
 
 def _cycle(model: Model, V: float, numerics: Numerics, convergence: Convergence, warn: bool,
-           start: CycleFixedPoint | None = None) -> Stationary:
-    """``stationary(method="cycle")``: steady rows from the renewal chain, stick-slip rows
-    from the fixed point of the shock-to-shock map (:mod:`micro.cycle`), and the
-    Fokker-Planck time-stepping where that map does not apply (shocks that are not total,
+           start: CycleFixedPoint | None = None, method: str = "cycle") -> Stationary:
+    """``stationary(method="cycle")`` and ``method="cohort"``: steady rows from the renewal
+    chain, stick-slip rows from the fixed point of the shock-to-shock map
+    (:mod:`micro.cycle`) or from the cohort method (:mod:`micro.cohort`), and the
+    Fokker-Planck time-stepping where they do not apply (shocks that are not total,
     jumps that are not exponential)."""
     direct = _direct_steady(model, V)
     if direct is not None:
         return direct
-    eps = numerics.eps if numerics.eps is not None else model.kappa * model.zbar * CYCLE_EPS_FRACTION
+    if method == "cohort":
+        eps = numerics.eps if numerics.eps is not None else model.kappa * model.zbar / 20.0
+    else:
+        eps = numerics.eps if numerics.eps is not None else model.kappa * model.zbar * CYCLE_EPS_FRACTION
     tol = convergence.rtol * (model.f_th - sigma_fast_limit(model)) + convergence.atol
     fallback = "jumps are not exponential"
     if model.jumps.kind == KIND_EXPONENTIAL:
-        res = cycle_fixed_point(model, V, eps, tol=tol, theta_shift=numerics.theta_shift,
-                                theta_relax=numerics.theta_relax, start=start)
+        if method == "cohort":
+            res = cycle_cohorts(model, V, h=eps, tol=tol, start=start)
+        else:
+            res = cycle_fixed_point(model, V, eps, tol=tol, theta_shift=numerics.theta_shift,
+                                    theta_relax=numerics.theta_relax, start=start)
         if res.applicable:
             if not res.converged and warn:
-                log.warning("micro.stationary(k0=%g, V=%g, method='cycle'): %s", model.k0, V, res.message)
+                log.warning("micro.stationary(k0=%g, V=%g, method=%r): %s", model.k0, V, method, res.message)
             return Stationary(
                 model=model, V=V, eps=eps, regime="stick-slip", sigma_max=res.sigma_max, sigma_min=res.sigma_min,
                 sigma_mean=res.sigma_mean, period=res.period, converged=res.converged, message=res.message,
@@ -411,7 +419,7 @@ def _cycle(model: Model, V: float, numerics: Numerics, convergence: Convergence,
                 mass_error=res.mass_error, min_mass=res.min_mass, cycle=res)
         fallback = res.message
     out = stationary(model, V, numerics=replace(numerics, eps=eps), convergence=convergence, warn=warn, method="fp")
-    out.message = f"cycle method not applicable ({fallback}): Fokker-Planck time-stepping; {out.message}"
+    out.message = f"{method} method not applicable ({fallback}): Fokker-Planck time-stepping; {out.message}"
     return out
 
 
@@ -458,6 +466,14 @@ def stationary(
     and says so in ``message``.  ``result.cycle`` holds the fixed point; passing it as
     ``initial`` at a nearby V starts the map there (fewer cycles).
 
+    ``method="cohort"``: the same rows from the cohort method
+    (:func:`micro.cohort.cycle_cohorts`), which keeps no grid in the margin: the blocks
+    born in one step are Exp(kappa zbar) in their margin at birth times a density in
+    delta_R, every crossed mass is an exact integral, and where a shock starts is a
+    continuous function of the state, so the cycles converge smoothly and are
+    extrapolated (``eps`` is its delta_R cell, default ``kappa * zbar / 20``; time step
+    0.01).  Same fallback and continuation as ``"cycle"``.
+
     ``method="auto"`` (the default) asks the renewal chain first
     (:func:`micro.steady_sliding`): where steady sliding is stable its stress is exact
     (to ~1e-11, in milliseconds) and no time-stepping is done; elsewhere, and whenever
@@ -482,11 +498,12 @@ def stationary(
         raise ValueError(f"method must be one of {', '.join(repr(m) for m in METHODS)}, got {method!r}")
     numerics = numerics or Numerics()
     convergence = convergence or Convergence()
-    if method == "cycle":
+    if method in ("cycle", "cohort"):
         if not (isinstance(initial, CycleFixedPoint) or (isinstance(initial, str) and initial == "auto")):
-            raise ValueError("with method='cycle', initial must be 'auto' or a previous result's .cycle "
+            raise ValueError(f"with method={method!r}, initial must be 'auto' or a previous result's .cycle "
                              f"(a micro.cycle.CycleFixedPoint), got {type(initial).__name__}")
-        return _cycle(model, V, numerics, convergence, warn, start=initial if isinstance(initial, CycleFixedPoint) else None)
+        return _cycle(model, V, numerics, convergence, warn,
+                      start=initial if isinstance(initial, CycleFixedPoint) else None, method=method)
     settings = numerics.settings(model)
     wants_fp_state = keep_grid or keep_records or not (isinstance(initial, str) and initial == "auto")
     if method == "auto" and not wants_fp_state:
@@ -940,8 +957,8 @@ def sweep(
     grid = None
     start = None
     for V in velocities:
-        if method == "cycle":
-            res = stationary(model, V, numerics=numerics, convergence=convergence, method="cycle",
+        if method in ("cycle", "cohort"):
+            res = stationary(model, V, numerics=numerics, convergence=convergence, method=method,
                              initial=start if (continuation and start is not None) else "auto")
             start = res.cycle if res.cycle is not None and res.cycle.applicable else start
             rows.append(res.to_dict())

@@ -1,0 +1,284 @@
+"""Numba kernels of :mod:`micro.cohort` (the loading phase as cohorts of exponential margins).
+
+Layout: cohort ``c`` has scalars (birth time ``t0``, mean slip ``X0`` and stress ``s0`` at
+birth, the dashpot integral ``J``), and ``nn[c]`` cells of width ``h`` in delta_R starting
+at node ``j0[c]``, stored from ``off[c]``: cell ``k`` keeps the density ``q`` and the floor
+``m`` (in units of the margin at birth) at both of its ends, at ``2 (off + k)`` and
+``2 (off + k) + 1``.  ``co[c]`` holds the step's coefficients: beta, the threshold ``D``
+at delta_R = 0, dD/d(delta_R), dD/d(dX), and exp(-gamma age).
+"""
+import math
+
+from numba import njit
+
+@njit(cache=True)
+def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, co):
+    """Fill ``co`` for a step of length ``dt`` from time ``t`` (slip ``X``, stress ``sigma``):
+    a member born with margin delta' crosses once delta' <= D0 + Dy delta_R + D1 dX, dX the
+    step's slip (the step's drive, dashpot relaxation and redistribution in it).  Returns
+    the weight of dX in the step's dashpot integral and exp(-gamma dt)."""
+    kappa = k0 + k1 + k2
+    r2 = k2 / kappa
+    alpha = 1.0 - r2
+    Edt = math.exp(-gamma * dt)
+    phi = 1.0 - (1.0 - Edt) / (gamma * dt) if dt > 0 else 0.0
+    b1 = k0 - kappa + k2 * phi
+    for c in range(n):
+        E = math.exp(-gamma * (t + dt - t0[c]))
+        beta = 1.0 - r2 * (1.0 - E)
+        dX0 = X - X0[c]
+        b0 = (f_th - sigma - k0 * V * dt - beta * (f_th - s0[c]) - kappa * dX0 + k2 * (J[c] * Edt + dX0 * (1.0 - Edt)))
+        co[c, 0] = beta
+        co[c, 1] = -b0 / beta  # D at y = 0
+        co[c, 2] = alpha * (1.0 - E) / beta  # dD/dy
+        co[c, 3] = -b1 / beta  # dD/ddX
+        co[c, 4] = E
+    return phi, Edt
+
+
+@njit(cache=True)
+def _i1(A, B, c, e):
+    """int_0^1 (A + B s) exp(-c - e s) ds (a series for small e)."""
+    if abs(e) < 1e-4:
+        return math.exp(-c) * (A * (1 - e / 2 + e * e / 6 - e ** 3 / 24) + B * (0.5 - e / 3 + e * e / 8 - e ** 3 / 30))
+    ee = math.exp(-e)
+    return math.exp(-c) * (A * (1 - ee) / e + B * (1 - ee * (1 + e)) / (e * e))
+
+
+@njit(cache=True)
+def _isub(q0, q1, m0, m1, a, b, lam):
+    """int_a^b q(s) exp(-m(s)/lam) ds, with q and m linear on [0, 1]."""
+    L = b - a
+    return L * _i1(q0 + (q1 - q0) * a, (q1 - q0) * L, (m0 + (m1 - m0) * a) / lam, (m1 - m0) * L / lam)
+
+
+@njit(cache=True)
+def _cell_range(d0, d1, ma, mb):
+    """The part [a, b] of a cell (local coordinate 0..1) where the threshold D is above
+    the floor (both linear); (-1, -1) if none."""
+    g0 = d0 - ma; g1 = d1 - mb
+    if g0 <= 0.0 and g1 <= 0.0:
+        return -1.0, -1.0
+    if g0 > 0.0 and g1 > 0.0:
+        return 0.0, 1.0
+    if g0 > 0.0:
+        return 0.0, g0 / (g0 - g1)
+    return g0 / (g0 - g1), 1.0
+
+
+@njit(cache=True)
+def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw):
+    """H(dX) = zbar * (jumps per block in the step if the slip is dX) - dX, and dH/d(dX).
+    First crossings are integrated exactly over each cell's crossed part; a block that
+    crossed jumps again as a Poisson process of rate 1/lam in its margin's overshoot
+    (exponential jumps), integrated by Gauss-Legendre (nodes ``gx``, weights ``gw``)."""
+    N = 0.0
+    dN = 0.0
+    for c in range(n):
+        beta = co[c, 0]
+        Da = co[c, 1] + co[c, 3] * dX
+        Dy = co[c, 2]
+        D1 = co[c, 3]
+        o = off[c]
+        for k in range(nn[c]):
+            y0 = ylo + (j0[c] + k) * h
+            d0 = Da + Dy * y0; d1 = d0 + Dy * h
+            i2 = 2 * (o + k)
+            ma = m[i2]; mb = m[i2 + 1]
+            a, b = _cell_range(d0, d1, ma, mb)
+            if a < 0.0:
+                continue
+            q0 = q[i2]; q1 = q[i2 + 1]
+            # first crossings, exact
+            cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
+            dcross = _isub(q0, q1, d0, d1, a, b, lam) / lam
+            rej = 0.0
+            L = (b - a)
+            for i in range(gx.size):
+                s = a + L * gx[i]
+                qv = q0 + (q1 - q0) * s
+                mv = ma + (mb - ma) * s
+                Dv = d0 + (d1 - d0) * s
+                em = math.exp(-mv / lam); eD = math.exp(-Dv / lam)
+                rej += gw[i] * qv * ((Dv - mv) * em - lam * (em - eD))
+            rej *= L * beta / lam
+            drej = beta / lam * (cross)
+            N += h * (cross + rej)
+            dN += h * (dcross + drej) * D1
+    return zbar * N - dX, zbar * dN - 1.0
+
+
+@njit(cache=True)
+def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw, tol, xmin):
+    """The smallest root of H (status 0), or status 1 if H has a positive local minimum
+    before it: the slip jumps, a fold (the start of a shock).  Newton from 0 with steps
+    capped at doubling (from ``xmin``) so that a minimum is not jumped over, then
+    safeguarded Newton in the bracket.  Status 2: no convergence."""
+    x = 0.0
+    H, dH = closure(x, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw)
+    if H <= 0.0:
+        return 0.0, 0
+    for it in range(400):
+        if dH >= 0.0:
+            return x, 1
+        xn = x - H / dH
+        cap = 2.0 * x + xmin
+        if xn > cap:
+            xn = cap
+        Hn, dHn = closure(xn, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw)
+        if Hn > 0.0:
+            x, H, dH = xn, Hn, dHn
+            continue
+        a, Ha, dHa, b = x, H, dH, xn
+        for k in range(300):
+            if dHa >= 0.0:
+                return a, 1
+            xt = a - Ha / dHa
+            if not (a < xt < b):
+                xt = 0.5 * (a + b)
+            Ht, dHt = closure(xt, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw)
+            if Ht > 0.0:
+                a, Ha, dHa = xt, Ht, dHt
+            else:
+                b = xt
+            if b - a <= 1e-13 * b or Ht == 0.0:
+                return b, 0
+        return b, 0
+    return x, 2
+
+
+@njit(cache=True)
+def _psi(cp, B, W, lam):
+    """E[(cp + B Z)_+] for Z ~ Exp(lam) truncated to [0, W] (W may be inf)."""
+    tail = math.exp(-W / lam) if W < 1e300 else 0.0
+    norm = 1.0 - tail
+    if cp >= 0.0:
+        # E[Z] of the truncated exponential
+        if W < 1e300:
+            EZ = (lam - (W + lam) * tail) / norm
+        else:
+            EZ = lam
+        return cp + B * EZ
+    z0 = -cp / B
+    if z0 >= W:
+        return 0.0
+    if W < 1e300:
+        return B * (lam * math.exp(-z0 / lam) - (W - z0 + lam) * tail) / norm
+    return B * lam * math.exp(-z0 / lam)
+
+
+@njit(cache=True)
+def deposit(dep, mass, ytop, B, W, lam, ylo, h):
+    """Deposit ``mass`` of Y = ytop - B Z (Z ~ Exp(lam) on [0, W]) on the hat functions of
+    the nodes ``ylo + j h`` exactly (second differences of E[(c - Y)_+]); a point when the
+    spread is below 1e-6 h.  Returns the mass that fell outside the nodes."""
+    ny = dep.size
+    span = B * min(W, 40.0 * lam)
+    if span < 1e-6 * h:
+        if W < 1e300:
+            tail = math.exp(-W / lam)
+            EZ = (lam - (W + lam) * tail) / (1.0 - tail) if W > 1e-12 * lam else 0.5 * W
+        else:
+            EZ = lam
+        u = (ytop - B * EZ - ylo) / h
+        jj = int(math.floor(u)); f = u - jj
+        if jj < 0 or jj + 1 >= ny:
+            return mass
+        dep[jj] += mass * (1.0 - f); dep[jj + 1] += mass * f
+        return 0.0
+    jlo = int(math.floor((ytop - span - ylo) / h)) - 1
+    jhi = int(math.ceil((ytop - ylo) / h)) + 1
+    out = 0.0
+    if jlo < 0 or jhi >= ny:
+        out = mass  # (only the part outside is lost; counted below)
+        jlo = max(jlo, 0); jhi = min(jhi, ny - 1)
+    tot = 0.0
+    for j in range(jlo, jhi + 1):
+        yj = ylo + j * h
+        w = (_psi(yj + h - ytop, B, W, lam) - 2.0 * _psi(yj - ytop, B, W, lam) + _psi(yj - h - ytop, B, W, lam)) / h
+        if w > 0.0:
+            dep[j] += mass * w
+            tot += w
+    if out > 0.0:
+        return mass * (1.0 - tot)
+    return 0.0
+
+
+@njit(cache=True)
+def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2, kappa, f_th, gx, gw, dep):
+    """Apply a step of slip ``dX``: the crossed members' delta_R (a linear function of
+    their margin at birth, so an exponential on a segment) is deposited exactly on the
+    hat functions of the nodes ``ylo + j h`` (``dep``: the newborn cohort, margins
+    Exp(lam) after their re-jumps); a crossed cell part gets a new floor, a line whose
+    survivor mass is exact.  Returns the mass that fell outside the nodes."""
+    r2 = k2 / kappa
+    ny = dep.size
+    bad = 0.0
+    for c in range(n):
+        beta = co[c, 0]; E = co[c, 4]
+        Da = co[c, 1] + co[c, 3] * dX
+        Dy = co[c, 2]
+        o = off[c]
+        Jn = J[c] * Edt + (X - X0[c]) * (1.0 - Edt) + phi * dX
+        for k in range(nn[c]):
+            y0 = ylo + (j0[c] + k) * h
+            d0 = Da + Dy * y0; d1 = d0 + Dy * h
+            i2 = 2 * (o + k)
+            ma = m[i2]; mb = m[i2 + 1]
+            a, b = _cell_range(d0, d1, ma, mb)
+            if a < 0.0:
+                continue
+            q0 = q[i2]; q1 = q[i2 + 1]
+            S_old = _isub(q0, q1, ma, mb, 0.0, 1.0, lam)
+            cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
+            if cross > 0.0:
+                # newborns at the Gauss points, scaled to the exact crossed mass
+                L = b - a
+                tot = 0.0
+                for i in range(gx.size):
+                    s = a + L * gx[i]
+                    qv = q0 + (q1 - q0) * s
+                    mv = ma + (mb - ma) * s
+                    Dv = d0 + (d1 - d0) * s
+                    tot += gw[i] * qv * (math.exp(-mv / lam) - math.exp(-Dv / lam))
+                for i in range(gx.size):
+                    s = a + L * gx[i]
+                    qv = q0 + (q1 - q0) * s
+                    mv = ma + (mb - ma) * s
+                    Dv = d0 + (d1 - d0) * s
+                    mass = gw[i] * qv * (math.exp(-mv / lam) - math.exp(-Dv / lam))
+                    if mass <= 0.0 or tot <= 0.0:
+                        continue
+                    mass *= h * cross / tot
+                    if mass < 1e-18:
+                        continue
+                    yv = y0 + s * h
+                    Btil = r2 * (1.0 - E)
+                    Atil = yv * E + r2 * (1.0 - E) * (f_th - s0[c] + yv) + k2 * Jn
+                    bad += deposit(dep, mass, Atil - Btil * mv, Btil, Dv - mv, lam, ylo, h)
+            # the new floor: a line in the cell with the exact survivor mass
+            if a == 0.0 and b == 1.0:
+                m[i2] = d0; m[i2 + 1] = d1
+            else:
+                S_new = S_old - cross
+                na = max(ma, d0); nb_ = max(mb, d1)
+                S_chord = _isub(q0, q1, na, nb_, 0.0, 1.0, lam)
+                if S_new > 0.0 and S_chord > 0.0:
+                    shift = -lam * math.log(S_new / S_chord)
+                else:
+                    shift = 0.0
+                m[i2] = na + shift; m[i2 + 1] = nb_ + shift
+        J[c] = Jn
+    return bad
+
+
+@njit(cache=True)
+def survivors(n, j0, nn, off, q, m, h, lam, out):
+    """The mass of every cohort that has not crossed yet."""
+    for c in range(n):
+        o = off[c]
+        s = 0.0
+        for k in range(nn[c]):
+            i2 = 2 * (o + k)
+            s += _isub(q[i2], q[i2 + 1], m[i2], m[i2 + 1], 0.0, 1.0, lam)
+        out[c] = s * h

@@ -1,0 +1,320 @@
+r"""Stick-slip cycles with total global shocks: the loading phase as cohorts of exponential margins.
+
+A grid-free solver of the mean-field dynamics (docs/reference/micro_cycle.md §6).  Between
+its own jumps a block's margin is linear in its state at its last jump, with
+coefficients common to all blocks born at the same time:
+
+.. math:: \delta(t) = \beta(\tau)\,\delta' + B(t; t_0) - \alpha (1 - e^{-\gamma\tau})\,\delta_R',
+          \qquad \beta(\tau) = 1 - \frac{k_2}{\kappa}(1 - e^{-\gamma\tau}),
+
+with :math:`\delta'` and :math:`\delta_R'` its margin and delta_R at birth, :math:`\tau`
+its age and :math:`\alpha = (k_0 + k_1)/\kappa`.  With exponential jumps every block
+that jumps leaves with :math:`\delta' \sim \mathrm{Exp}(\kappa\bar z)`, independent of the
+rest.  So the blocks born in one step (a *cohort*) are Exp(kappa zbar) in
+:math:`\delta'` times a density in :math:`\delta_R'`, and the members that have not
+jumped again are those above a floor :math:`\delta' > m(\delta_R')`.  Nothing is
+discretised in the margin: a cohort's density is piecewise linear on cells of width
+``h`` in delta_R, each cell with a linear floor, and every crossed mass is an exact
+integral of an exponential.  A step of length ``dt`` solves the mean-field closure for its
+slip (``dX = zbar x`` the jumps it causes, a crossed block jumping again as a Poisson
+process of its overshoot); the loading phase ends where the closure's smallest root
+jumps (a fold), located by bisecting the step; the shock is the same closure in zero
+time.  Where a near-critical avalanche runs away is then a continuous function of
+the state, so the cycle-to-cycle sequence converges smoothly (geometrically, by about
+0.8 per cycle) and is extrapolated by Aitken's method.
+
+Refinement variables: the time step ``dt`` and the cell width ``h`` (measured orders
+in benchmarks/micro_cohort_refinement.py).  Applies to exponential jumps and total
+shocks; otherwise the result says ``applicable=False``.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import time
+
+import numpy as np
+
+from . import _cohort_kernels as CK
+from .cycle import UNJUMPED_TOL, CycleFixedPoint
+from .params import KIND_EXPONENTIAL, Model
+
+__all__ = ["cycle_cohorts"]
+
+log = logging.getLogger(__name__)
+
+_GX, _GW = np.polynomial.legendre.leggauss(4)
+_GX, _GW = 0.5 * _GX + 0.5, 0.5 * _GW
+#: Cohorts whose surviving mass is below this are dropped.
+SURVIVOR_FLOOR = 1e-17
+#: The start of a shock is located to this fraction of the time step.
+FOLD_TOL = 1e-7
+
+
+class _Cohorts:
+    """The state: the cohorts (module docstring), the time, the slip and the stress."""
+
+    def __init__(self, model: Model, V: float, h: float) -> None:
+        self.model, self.V, self.h = model, V, h
+        self.lam = model.kappa * model.zbar
+        # delta_R lies within (k2 / kappa) * 40 lam of 0 for all but 1e-17 of the mass
+        half = int(math.ceil(45.0 * model.k2 * model.zbar / h)) + 8
+        self.ylo, self.ny = -half * h, 2 * half
+        cap = 1024
+        self.t0, self.X0, self.s0, self.J = (np.zeros(cap) for _ in range(4))
+        self.j0, self.nn, self.off = (np.zeros(cap, np.int64) for _ in range(3))
+        self.co = np.zeros((cap, 5))
+        self.q, self.m = np.zeros(1 << 16), np.zeros(1 << 16)
+        self.n = self.pool = 0
+        self.t = self.X = self.sigma = 0.0
+        self.last = 0.0
+        self.outside = 0.0
+
+    # -------------------------------------------------------------- storage
+    def add(self, dep: np.ndarray) -> None:
+        """A new cohort born now, with node masses ``dep`` in delta_R and floors 0."""
+        idx = np.flatnonzero(dep > 0.0)
+        if idx.size == 0:
+            return
+        a, b = max(idx[0] - 1, 0), min(idx[-1] + 2, self.ny)  # a node of zero density at each end
+        cells = b - a - 1
+        if self.n + 1 > self.t0.size or 2 * (self.pool + cells) > self.q.size:
+            self.compact()
+            if self.n + 1 > self.t0.size:
+                for name in ("t0", "X0", "s0", "J", "j0", "nn", "off"):
+                    old = getattr(self, name)
+                    setattr(self, name, np.concatenate([old, np.zeros_like(old)]))
+                self.co = np.zeros((self.t0.size, 5))
+            if 2 * (self.pool + cells) > self.q.size:
+                extra = self.q.size + 2 * cells
+                self.q = np.concatenate([self.q, np.zeros(extra)])
+                self.m = np.concatenate([self.m, np.zeros(extra)])
+        c, p = self.n, self.pool
+        self.t0[c], self.X0[c], self.s0[c], self.J[c] = self.t, self.X, self.sigma, 0.0
+        self.j0[c], self.nn[c], self.off[c] = a, cells, p
+        nodes = dep[a:b] / self.h
+        self.q[2 * p:2 * (p + cells):2] = nodes[:-1]
+        self.q[2 * p + 1:2 * (p + cells):2] = nodes[1:]
+        self.m[2 * p:2 * (p + cells)] = 0.0
+        self.pool += cells
+        self.n += 1
+
+    def surviving(self) -> np.ndarray:
+        out = np.zeros(self.n)
+        CK.survivors(self.n, self.j0, self.nn, self.off, self.q, self.m, self.h, self.lam, out)
+        return out
+
+    def compact(self) -> None:
+        """Drop the cohorts that have all but crossed, and pack the cells."""
+        keep = np.flatnonzero(self.surviving() > SURVIVOR_FLOOR)
+        q, m = np.zeros_like(self.q), np.zeros_like(self.m)
+        p = 0
+        for i, c in enumerate(keep):
+            k, o = self.nn[c], self.off[c]
+            q[2 * p:2 * (p + k)] = self.q[2 * o:2 * (o + k)]
+            m[2 * p:2 * (p + k)] = self.m[2 * o:2 * (o + k)]
+            for name in ("t0", "X0", "s0", "J", "j0", "nn"):
+                getattr(self, name)[i] = getattr(self, name)[c]
+            self.off[i] = p
+            p += k
+        self.q, self.m, self.pool, self.n = q, m, p, keep.size
+
+    # -------------------------------------------------------------- dynamics
+    def prepare(self, dt: float) -> tuple[float, float]:
+        md = self.model
+        return CK.coefficients(self.t, dt, self.X, self.sigma, self.V, md.k0, md.k1, md.k2, md.f_th, md.gamma,
+                               self.t0, self.X0, self.s0, self.J, self.n, self.co)
+
+    def closure(self, dX: float) -> tuple[float, float]:
+        return CK.closure(dX, self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
+                          self.lam, self.model.zbar, _GX, _GW)
+
+    def root(self) -> tuple[float, int]:
+        """The step's slip (after :meth:`prepare`) and 0, or 1 if the step starts a shock."""
+        xmin = max(1e-9 * self.model.zbar, 0.25 * self.last)
+        return CK.smallest_root(self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
+                                self.lam, self.model.zbar, _GX, _GW, 1e-16, xmin)
+
+    def commit(self, dX: float, dt: float, phi: float, Edt: float) -> None:
+        md = self.model
+        dep = np.zeros(self.ny)
+        self.outside += CK.commit(dX, self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.J, self.X0,
+                                  self.s0, self.X, Edt, phi, self.ylo, self.h, self.lam, md.k2, md.kappa, md.f_th,
+                                  _GX, _GW, dep)
+        if dt > 0.0:
+            self.last = dX
+        self.t += dt
+        self.X += dX
+        self.sigma += md.k0 * (self.V * dt - dX)
+        self.add(dep)
+
+    def shock_root(self, x0: float) -> float:
+        """The slip of the shock: the closure's root beyond its positive minimum (after
+        :meth:`prepare` with dt = 0), bracketed by doubling, then bisected."""
+        lo, hi = x0, max(2.0 * x0, self.model.zbar)
+        while self.closure(hi)[0] > 0.0:
+            lo, hi = hi, 2.0 * hi
+            if hi > 1e12:
+                raise RuntimeError("the shock's closure has no root")
+        while hi - lo > 1e-14 * hi:
+            mid = 0.5 * (lo + hi)
+            if self.closure(mid)[0] > 0.0:
+                lo = mid
+            else:
+                hi = mid
+        return hi
+
+
+def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | None) -> _Cohorts:
+    """The state after a total shock: Exp(kappa zbar) margins times a delta_R marginal,
+    ``p`` (nodes, masses) or every dashpot relaxed to the lag of an Exp margin."""
+    st = _Cohorts(model, V, h)
+    if p is None:
+        lam = st.lam
+        delta = (np.arange(4000) + 0.5) * (lam * 40.0 / 4000)
+        w = np.exp(-delta / lam)
+        y, w = model.k2 / model.kappa * (lam - delta), w / w.sum()
+    else:
+        y, w = p[0], p[1] / p[1].sum()
+    u = (y - st.ylo) / h
+    i = np.floor(u).astype(np.int64)
+    if i.min() < 0 or i.max() + 1 >= st.ny:
+        raise ValueError("the starting delta_R marginal lies outside the nodes")
+    f = u - i
+    dep = np.zeros(st.ny)
+    np.add.at(dep, i, w * (1.0 - f))
+    np.add.at(dep, i + 1, w * f)
+    st.sigma = model.f_th - st.lam + float(dep @ (st.ylo + np.arange(st.ny) * h))
+    st.add(dep)
+    return st
+
+
+def _one_cycle(st: _Cohorts, dt: float) -> dict:
+    """Load in steps of ``dt`` until a step starts a shock, locate the shock's start by
+    bisecting that step, then apply the shock."""
+    t_start, sigma_start, integral = st.t, st.sigma, 0.0
+    t_max = 20.0 * st.lam / (st.model.k0 * st.V)
+    while True:
+        if st.t - t_start > t_max:
+            return dict(ok=False, message=f"no shock within t = {t_max:.3g} of the last one")
+        phi, Edt = st.prepare(dt)
+        x, status = st.root()
+        if status == 2:
+            return dict(ok=False, message="the closure of a step did not converge")
+        if status == 0:
+            s0 = st.sigma
+            st.commit(x, dt, phi, Edt)
+            integral += 0.5 * (s0 + st.sigma) * dt
+            continue
+        lo, hi = 0.0, dt
+        while hi - lo > FOLD_TOL * dt:
+            mid = 0.5 * (lo + hi)
+            st.prepare(mid)
+            if st.root()[1] == 0:
+                lo = mid
+            else:
+                hi = mid
+        if lo > 0.0:
+            phi, Edt = st.prepare(lo)
+            x, _ = st.root()
+            s0 = st.sigma
+            st.commit(x, lo, phi, Edt)
+            integral += 0.5 * (s0 + st.sigma) * lo
+        break
+    sigma_max, period = st.sigma, st.t - t_start
+    st.prepare(0.0)
+    x, _ = st.root()
+    n_old = st.n
+    st.commit(st.shock_root(max(x, 1e-12 * st.model.zbar)), 0.0, 0.0, 1.0)
+    unjumped = float(st.surviving()[:n_old].sum())
+    st.compact()
+    return dict(ok=True, sigma_max=sigma_max, sigma_min=st.sigma, period=period,
+                sigma_mean=integral / period if period > 0 else sigma_max, unjumped=unjumped,
+                start=sigma_start)
+
+
+def _aitken(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Aitken's extrapolation of the last three rows of ``a`` (one column per quantity),
+    and the ratio of the last two differences."""
+    d1, d2 = a[-2] - a[-3], a[-1] - a[-2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rho = np.where(d1 != 0.0, d2 / d1, 0.0)
+        corr = np.where((rho >= 0.0) & (rho < 1.0), d2 * rho / (1.0 - rho), 0.0)
+    return a[-1] + corr, rho
+
+
+def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None = None, tol: float = 1e-5,
+                  max_iter: int = 200, start: CycleFixedPoint | None = None) -> CycleFixedPoint:
+    """The stick-slip limit cycle at drive velocity ``V`` with total global shocks, by the
+    cohort method (module docstring), iterated cycle to cycle from ``start`` (a result at
+    a nearby V or another ``h``) or from the first shock's image.
+
+    The sequence of cycle extrema converges geometrically; the result is Aitken's
+    extrapolation of the last three cycles, stopped when two consecutive extrapolations
+    of sigma_max and sigma_min agree to ``tol / 2`` with a contraction ratio in [0, 0.95];
+    ``error`` is twice that change.  It is the error of the fixed point at this ``dt`` and
+    ``h``, not their discretisation error (``h`` defaults to ``kappa zbar / 20``).
+    ``eps`` in the result is ``h``.
+    """
+    begin = time.perf_counter()
+    if model.jumps.kind != KIND_EXPONENTIAL:
+        raise ValueError("the cohort method needs exponential jumps (a jumped block's margin is then Exp(kappa zbar))")
+    h = model.kappa * model.zbar / 20.0 if h is None else h
+    for name, value in (("V", V), ("dt", dt), ("h", h), ("tol", tol)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    if not h <= model.kappa * model.zbar:
+        raise ValueError(f"h must be at most kappa * zbar = {model.kappa * model.zbar:g}, got {h!r}")
+    if int(max_iter) != max_iter or max_iter < 4:
+        raise ValueError(f"max_iter must be an integer >= 4, got {max_iter!r}")
+    st = _start(model, V, h, start.p if start is not None else None)
+    hist: list[tuple[float, float, float, float]] = []
+    error, converged, applicable, message = math.nan, False, True, ""
+    value = np.full(4, math.nan)
+    previous = None
+    out: dict = {}
+    for it in range(1, int(max_iter) + 1):
+        out = _one_cycle(st, dt)
+        if not out["ok"]:
+            applicable, message = False, out["message"]
+            break
+        if out["unjumped"] > UNJUMPED_TOL:
+            applicable = False
+            message = (f"the shock left {out['unjumped']:.2g} of the mass unjumped (> {UNJUMPED_TOL:g}): "
+                       "not a total shock; use method='fp'")
+            break
+        if st.outside > 1e-12:
+            message = f"the delta_R marginal left the nodes ({st.outside:.2g} of the mass)"
+            break
+        hist.append((out["sigma_max"], out["sigma_min"], out["period"], out["sigma_mean"]))
+        log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f", it, out["sigma_max"], out["sigma_min"])
+        if len(hist) >= 3:
+            extrapolated, rho = _aitken(np.array(hist))
+            if previous is not None:
+                change = float(np.max(np.abs(extrapolated[:2] - previous[:2])))
+                error = 2.0 * change
+                ok_ratio = bool(np.all((rho[:2] >= 0.0) & (rho[:2] <= 0.95)) or change == 0.0)
+                if ok_ratio and error <= tol:
+                    converged, value = True, extrapolated
+                    message = (f"limit cycle by cohorts: Aitken's extrapolation of cycles {it - 2}-{it} (of {it}) "
+                               f"moved by {change:.1e}; sigma_max and sigma_min to {error:.1e}")
+                    break
+            previous = extrapolated
+    else:
+        message = f"no fixed point to {tol:g} in {max_iter} cycles (error estimate {error:.2g})"
+    values = np.array(hist).reshape(-1, 4)
+    if not converged and len(values):
+        value = values[-1]
+    res = CycleFixedPoint(
+        model=model, V=V, eps=h, sigma_max=float(value[0]), sigma_min=float(value[1]), period=float(value[2]),
+        sigma_mean=float(value[3]), mass_error=float(st.outside), min_mass=0.0, iterations=len(hist), error=error,
+        unjumped=out.get("unjumped", math.nan), converged=converged, message=message,
+        wall_time=time.perf_counter() - begin, applicable=applicable, history=values)
+    if applicable and len(hist) and st.n == 1:
+        c = 0
+        nodes = st.ylo + (st.j0[c] + np.arange(st.nn[c] + 1)) * h
+        o, k = st.off[c], st.nn[c]
+        dens = np.concatenate([st.q[2 * o:2 * (o + k):2], [st.q[2 * (o + k) - 1]]])
+        keep = dens > 0.0
+        res.p = (nodes[keep], dens[keep] * h)
+    return res

@@ -1,0 +1,92 @@
+"""Stick-slip cycles by cohorts of exponential margins (``method="cohort"``).
+
+Checks that share no code with the method: the exact stress after a total shock
+(``micro.sigma_fast_limit``), the branching ratio of the state after a total shock
+(1 - k0/kappa, by hand), the exact moments of a deposit, and the Fokker-Planck solvers'
+sigma_max at the same point.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import micro
+from micro import _cohort_kernels as CK
+from micro.cohort import _start, cycle_cohorts
+
+
+def test_state_after_a_total_shock_has_branching_ratio_one_minus_k0_over_kappa():
+    """Exp(kappa zbar) margins: the density at the threshold is 1/(kappa zbar), so an
+    avalanche's branching ratio is (k1 + k2)/kappa and dH/d(dX) = -k0/kappa at dX = 0,
+    whatever the delta_R marginal (to the re-jumps' O(dX)); the stress is f_th - kappa zbar + <delta_R>."""
+    model = micro.Model(k0=0.01)
+    y = np.array([-0.05, 0.0, 0.02])
+    st = _start(model, 1.0, model.kappa * model.zbar / 20, (y, np.array([0.2, 0.5, 0.3])))
+    assert st.sigma == pytest.approx(micro.sigma_fast_limit(model) + 0.2 * -0.05 + 0.3 * 0.02, abs=1e-14)
+    st.prepare(0.0)
+    assert st.closure(0.0)[0] == pytest.approx(0.0, abs=1e-15)
+    H, dH = st.closure(1e-9 * model.zbar)  # (the right derivative: the floors are at the threshold)
+    assert dH == pytest.approx(-model.k0 / model.kappa, rel=1e-6)
+
+
+@pytest.mark.parametrize("W", [0.03, math.inf])
+def test_deposit_keeps_mass_and_mean(W):
+    """The hat-function deposit of Y = ytop - B Z, Z ~ Exp(lam) on [0, W], keeps the mass
+    and the mean exactly (E[Z] of the truncated exponential, by hand)."""
+    lam, B, ytop, h = 0.1, 0.8, 0.013, 0.005
+    dep = np.zeros(1000)
+    ylo = -4.0  # (the deposit covers 40 lam of Z)
+    assert CK.deposit(dep, 0.7, ytop, B, W, lam, ylo, h) == 0.0
+    EZ = lam if math.isinf(W) else lam - W * math.exp(-W / lam) / (1.0 - math.exp(-W / lam))
+    y = ylo + h * np.arange(dep.size)
+    assert dep.sum() == pytest.approx(0.7, rel=1e-10)
+    assert (dep @ y) / dep.sum() == pytest.approx(ytop - B * EZ, abs=1e-10)
+    assert dep.min() >= 0.0
+
+
+def test_cohort_cycle_matches_the_fokker_planck_solvers_and_the_exact_sigma_min():
+    """k0 = 0.01, V = 0.3 V^c.  sigma_min is f_th - kappa zbar (0.899) to the method's
+    O(dt) error; sigma_max lies within the spread of the Fokker-Planck results at this
+    point (time-stepping 0.959337 and 0.959577, the shock-to-shock map 0.959632 and
+    0.959419, at eps = 0.0168 and 0.0126: benchmarks/results/micro_cycle_speed.csv)."""
+    model = micro.Model(k0=0.01)
+    res = cycle_cohorts(model, 2.403, dt=0.02, h=0.01, tol=1e-4)
+    assert res.converged and res.applicable, res.message
+    assert abs(res.sigma_min - micro.sigma_fast_limit(model)) < 1e-4
+    assert 0.95934 - 3e-4 < res.sigma_max < 0.95963 + 3e-4
+    assert res.error <= 1e-4
+    # the starting marginal is the previous fixed point: fewer cycles
+    again = cycle_cohorts(model, 2.403, dt=0.02, h=0.01, tol=1e-4, start=res)
+    assert again.iterations < res.iterations
+    assert again.sigma_max == pytest.approx(res.sigma_max, abs=2e-4)
+
+
+def test_cycle_sequence_is_smooth_at_small_k0():
+    """At k0 = 1e-3 the cycle-to-cycle sequence of sigma_max converges monotonically with
+    a steady contraction ratio (the shock-to-shock map on the grid jitters by ~k0 eps
+    there): what makes the Aitken extrapolation valid."""
+    model = micro.Model(k0=0.001)
+    res = cycle_cohorts(model, 24.27, dt=0.02, h=0.01, tol=1e-9, max_iter=10)
+    d = np.diff(res.history[:, 0])
+    assert np.all(d < 0.0), d
+    rho = d[1:] / d[:-1]
+    assert np.all((rho > 0.5) & (rho < 0.95)), rho
+
+
+def test_cohort_falls_back_where_shocks_are_not_total():
+    model = micro.Model(k0=0.3)
+    res = micro.stationary(model, 0.1, method="cohort", numerics=micro.Numerics(eps=0.025),
+                           convergence=micro.Convergence(rtol=5e-2, t_max=40.0), warn=False)
+    assert "cohort method not applicable" in res.message
+
+
+def test_cohort_rejects_bad_input():
+    with pytest.raises(ValueError, match="exponential"):
+        cycle_cohorts(micro.Model(k0=0.01, jumps=micro.Deterministic(0.1)), 1.0)
+    for kwargs, name in (({"dt": 0.0}, "dt"), ({"h": -1.0}, "h"), ({"h": 1.0}, "h"), ({"tol": math.nan}, "tol")):
+        with pytest.raises(ValueError, match=name):
+            cycle_cohorts(micro.Model(k0=0.01), 1.0, **kwargs)
+    with pytest.raises(ValueError, match="method"):
+        micro.stationary(micro.Model(k0=0.01), 1.0, method="cohorts")
