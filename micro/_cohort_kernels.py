@@ -5,14 +5,15 @@ birth, the dashpot integral ``J``), and ``nn[c]`` cells of width ``h`` in delta_
 at node ``j0[c]``, stored from ``off[c]``: cell ``k`` keeps the density ``q`` and the floor
 ``m`` (in units of the margin at birth) at both of its ends, at ``2 (off + k)`` and
 ``2 (off + k) + 1``.  ``co[c]`` holds the step's coefficients: beta, the threshold ``D``
-at delta_R = 0, dD/d(delta_R), dD/d(dX), and exp(-gamma age).
+at delta_R = 0, dD/d(delta_R), dD/d(dX), exp(-gamma age), and the smallest gap between
+floor and threshold at dX = 0 (cohorts that cannot cross are skipped).
 """
 import math
 
 from numba import njit
 
 @njit(cache=True)
-def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, co):
+def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, co, j0, nn, off, m, ylo, h):
     """Fill ``co`` for a step of length ``dt`` from time ``t`` (slip ``X``, stress ``sigma``):
     a member born with margin delta' crosses once delta' <= D0 + Dy delta_R + D1 dX, dX the
     step's slip (the step's drive, dashpot relaxation and redistribution in it).  Returns
@@ -33,6 +34,17 @@ def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, 
         co[c, 2] = alpha * (1.0 - E) / beta  # dD/dy
         co[c, 3] = -b1 / beta  # dD/ddX
         co[c, 4] = E
+        # the smallest gap between the floor and the threshold at dX = 0: no member of
+        # the cohort crosses while co[c, 3] * dX stays below it
+        gap = math.inf
+        o = off[c]
+        for k in range(nn[c]):
+            d0 = co[c, 1] + co[c, 2] * (ylo + (j0[c] + k) * h)
+            i2 = 2 * (o + k)
+            g = min(m[i2] - d0, m[i2 + 1] - d0 - co[c, 2] * h)
+            if g < gap:
+                gap = g
+        co[c, 5] = gap
     return phi, Edt
 
 
@@ -75,6 +87,8 @@ def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw):
     N = 0.0
     dN = 0.0
     for c in range(n):
+        if co[c, 3] * dX <= co[c, 5]:
+            continue
         beta = co[c, 0]
         Da = co[c, 1] + co[c, 3] * dX
         Dy = co[c, 2]
@@ -220,6 +234,9 @@ def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2
         Dy = co[c, 2]
         o = off[c]
         Jn = J[c] * Edt + (X - X0[c]) * (1.0 - Edt) + phi * dX
+        J[c] = Jn
+        if co[c, 3] * dX <= co[c, 5]:
+            continue
         for k in range(nn[c]):
             y0 = ylo + (j0[c] + k) * h
             d0 = Da + Dy * y0; d1 = d0 + Dy * h
@@ -268,7 +285,6 @@ def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2
                 else:
                     shift = 0.0
                 m[i2] = na + shift; m[i2 + 1] = nb_ + shift
-        J[c] = Jn
     return bad
 
 

@@ -43,12 +43,14 @@ __all__ = ["cycle_cohorts"]
 
 log = logging.getLogger(__name__)
 
-_GX, _GW = np.polynomial.legendre.leggauss(4)
+_GX, _GW = np.polynomial.legendre.leggauss(2)
 _GX, _GW = 0.5 * _GX + 0.5, 0.5 * _GW
 #: Cohorts whose surviving mass is below this are dropped.
 SURVIVOR_FLOOR = 1e-17
 #: The start of a shock is located to this fraction of the time step.
 FOLD_TOL = 1e-7
+#: Passed as ``start``: begin from the first shock's image, without a coarser run first.
+_NO_COARSE = object()
 
 
 class _Cohorts:
@@ -63,7 +65,7 @@ class _Cohorts:
         cap = 1024
         self.t0, self.X0, self.s0, self.J = (np.zeros(cap) for _ in range(4))
         self.j0, self.nn, self.off = (np.zeros(cap, np.int64) for _ in range(3))
-        self.co = np.zeros((cap, 5))
+        self.co = np.zeros((cap, 6))
         self.q, self.m = np.zeros(1 << 16), np.zeros(1 << 16)
         self.n = self.pool = 0
         self.t = self.X = self.sigma = 0.0
@@ -84,7 +86,7 @@ class _Cohorts:
                 for name in ("t0", "X0", "s0", "J", "j0", "nn", "off"):
                     old = getattr(self, name)
                     setattr(self, name, np.concatenate([old, np.zeros_like(old)]))
-                self.co = np.zeros((self.t0.size, 5))
+                self.co = np.zeros((self.t0.size, 6))
             if 2 * (self.pool + cells) > self.q.size:
                 extra = self.q.size + 2 * cells
                 self.q = np.concatenate([self.q, np.zeros(extra)])
@@ -123,7 +125,8 @@ class _Cohorts:
     def prepare(self, dt: float) -> tuple[float, float]:
         md = self.model
         return CK.coefficients(self.t, dt, self.X, self.sigma, self.V, md.k0, md.k1, md.k2, md.f_th, md.gamma,
-                               self.t0, self.X0, self.s0, self.J, self.n, self.co)
+                               self.t0, self.X0, self.s0, self.J, self.n, self.co, self.j0, self.nn, self.off,
+                               self.m, self.ylo, self.h)
 
     def closure(self, dX: float) -> tuple[float, float]:
         return CK.closure(dX, self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
@@ -178,8 +181,10 @@ def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | 
         y, w = p[0], p[1] / p[1].sum()
     u = (y - st.ylo) / h
     i = np.floor(u).astype(np.int64)
-    if i.min() < 0 or i.max() + 1 >= st.ny:
-        raise ValueError("the starting delta_R marginal lies outside the nodes")
+    inside = (i >= 0) & (i + 1 < st.ny)
+    if w[~inside].sum() > 1e-12:
+        raise ValueError(f"the starting delta_R marginal lies outside the nodes ({w[~inside].sum():.2g} of its mass)")
+    u, i, w = u[inside], i[inside], w[inside]  # (the nodes' range depends on h: negligible tails may fall off)
     f = u - i
     dep = np.zeros(st.ny)
     np.add.at(dep, i, w * (1.0 - f))
@@ -244,10 +249,12 @@ def _aitken(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None = None, tol: float = 1e-5,
-                  max_iter: int = 200, start: CycleFixedPoint | None = None) -> CycleFixedPoint:
+                  max_iter: int = 200, start=None) -> CycleFixedPoint:
     """The stick-slip limit cycle at drive velocity ``V`` with total global shocks, by the
     cohort method (module docstring), iterated cycle to cycle from ``start`` (a result at
-    a nearby V or another ``h``) or from the first shock's image.
+    a nearby V or another ``h``, of this method or :func:`micro.cycle.cycle_fixed_point`).
+    Without one, the transient cycles run at twice ``dt`` and ``h`` first (from the
+    first shock's image), and their fixed point is the start.
 
     The sequence of cycle extrema converges geometrically; the result is Aitken's
     extrapolation of the last three cycles, stopped when two consecutive extrapolations
@@ -267,7 +274,14 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         raise ValueError(f"h must be at most kappa * zbar = {model.kappa * model.zbar:g}, got {h!r}")
     if int(max_iter) != max_iter or max_iter < 4:
         raise ValueError(f"max_iter must be an integer >= 4, got {max_iter!r}")
-    st = _start(model, V, h, start.p if start is not None else None)
+    if start is None and h <= 0.5 * model.kappa * model.zbar:
+        # the transient cycles at twice the steps and cells (an eighth of the cost), to a
+        # looser tolerance: the fixed point there is the start (as a coarser h in a sweep)
+        coarse = cycle_cohorts(model, V, dt=2.0 * dt, h=2.0 * h, tol=max(4.0 * tol, 1e-4), max_iter=max_iter,
+                               start=_NO_COARSE)
+        if coarse.applicable and coarse.p is not None:
+            start = coarse
+    st = _start(model, V, h, start.p if start is not None and start is not _NO_COARSE else None)
     hist: list[tuple[float, float, float, float]] = []
     error, converged, applicable, message = math.nan, False, True, ""
     value = np.full(4, math.nan)

@@ -1,0 +1,76 @@
+"""Refinement study of the cohort method (``micro.cohort``), run time against error.
+
+Points: Fig. 4 parameters, V = 0.3 V^c, k0 = 1e-2, 1e-3 and 1e-4.  The two refinement
+variables, the time step dt and the delta_R cell h, are halved together from
+(0.02, 0.01) to (0.005, 0.0025); each level starts from the previous level's fixed point
+and is converged to tol = 1e-6 (Aitken's extrapolation of the cycles).  The order p
+and the limit come from the three levels (sigma(l) = sigma_0 + C 2^(-p l)); sigma_min
+has an exact limit, f_th - kappa zbar: the check of the procedure.  Each row's
+"distance" is its distance from the extrapolated limit: the error that its run time
+bought.
+
+Writes benchmarks/results/micro_cohort_refinement.csv.
+
+    python benchmarks/micro_cohort_refinement.py        # about 10 minutes on 1 core
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+import micro
+from micro.cohort import cycle_cohorts
+
+HERE = Path(__file__).resolve().parent
+LEVELS = ((0.02, 0.01), (0.01, 0.005), (0.005, 0.0025))
+
+
+def order_and_limit(s: np.ndarray) -> tuple[float, float]:
+    """From three levels each halving the steps: the order and the Richardson limit."""
+    d1, d2 = s[0] - s[1], s[1] - s[2]
+    if d2 == 0.0 or d1 / d2 <= 0.0:
+        return math.nan, float(s[2])
+    p = math.log2(d1 / d2)
+    return p, float(s[2] - d2 / (2.0**p - 1.0))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--k0", default="0.01,0.001,0.0001")
+    ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_refinement.csv"))
+    args = ap.parse_args()
+    rows = []
+    cycle_cohorts(micro.Model(k0=0.01), 2.4, dt=0.05, h=0.02, tol=1e-2, max_iter=4)  # compile
+    for k0 in (float(v) for v in args.k0.split(",")):
+        model = micro.Model(k0=k0)
+        V = 0.3 * micro.critical_velocity(model).Vc
+        start = None
+        for dt, h in LEVELS:
+            t = time.perf_counter()
+            res = cycle_cohorts(model, V, dt=dt, h=h, tol=1e-6, start=start)
+            wall = time.perf_counter() - t
+            start = res
+            rows.append(dict(k0=k0, V=V, dt=dt, h=h, sigma_max=res.sigma_max, sigma_min=res.sigma_min,
+                             exact_sigma_min=micro.sigma_fast_limit(model), period=res.period, error=res.error,
+                             cycles=res.iterations, converged=res.converged, wall_s=wall))
+            print(rows[-1], flush=True)
+    frame = pd.DataFrame(rows)
+    for k0, grp in frame.groupby("k0", sort=False):
+        for col in ("sigma_max", "sigma_min"):
+            p, lim = order_and_limit(grp[col].to_numpy())
+            frame.loc[grp.index, f"{col}_order"] = p
+            frame.loc[grp.index, f"{col}_limit"] = lim
+            frame.loc[grp.index, f"{col}_distance"] = (grp[col] - lim).abs()
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(args.out, index=False)
+    with pd.option_context("display.width", 200, "display.max_columns", 30):
+        print(frame)
+
+
+if __name__ == "__main__":
+    main()
