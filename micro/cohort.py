@@ -49,6 +49,8 @@ _GX, _GW = 0.5 * _GX + 0.5, 0.5 * _GW
 SURVIVOR_FLOOR = 1e-17
 #: The start of a shock is located to this fraction of the time step.
 FOLD_TOL = 1e-7
+#: A last step d between cycles leaves at most STILL * d to go when they contract by 0.8 a cycle.
+STILL = 5.0
 #: Passed as ``start``: begin from the first shock's image, without a coarser run first.
 _NO_COARSE = object()
 
@@ -258,8 +260,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
 
     The sequence of cycle extrema converges geometrically; the result is Aitken's
     extrapolation of the last three cycles, stopped when two consecutive extrapolations
-    of sigma_max and sigma_min agree to ``tol / 2`` with a contraction ratio in [0, 0.95];
-    ``error`` is twice that change.  It is the error of the fixed point at this ``dt`` and
+    of sigma_max and sigma_min agree to ``tol / 2`` with a contraction ratio in [0, 0.95]
+    (``error`` is twice that change), or the last cycle when it moved by less than
+    ``tol / STILL`` (``error`` is STILL times that step).  It is the error of the fixed point at this ``dt`` and
     ``h``, not their discretisation error (``h`` defaults to ``kappa zbar / 20``).
     ``eps`` in the result is ``h``.
     """
@@ -304,14 +307,18 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f", it, out["sigma_max"], out["sigma_min"])
         if len(hist) >= 3:
             extrapolated, rho = _aitken(np.array(hist))
+            step = max(abs(hist[-1][i] - hist[-2][i]) for i in (0, 1))
             if previous is not None:
                 change = float(np.max(np.abs(extrapolated[:2] - previous[:2])))
-                error = 2.0 * change
-                ok_ratio = bool(np.all((rho[:2] >= 0.0) & (rho[:2] <= 0.95)) or change == 0.0)
-                if ok_ratio and error <= tol:
-                    converged, value = True, extrapolated
-                    message = (f"limit cycle by cohorts: Aitken's extrapolation of cycles {it - 2}-{it} (of {it}) "
-                               f"moved by {change:.1e}; sigma_max and sigma_min to {error:.1e}")
+                ok_ratio = bool(np.all((rho[:2] >= 0.0) & (rho[:2] <= 0.95)))
+                # Aitken's estimate while the differences contract steadily; once the cycles
+                # agree to round-off the ratios are noise, and the last step (times the
+                # tail of a contraction by 0.8) bounds the error
+                error = min(2.0 * change if ok_ratio else math.inf, STILL * step)
+                if error <= tol:
+                    converged, value = True, (extrapolated if 2.0 * change == error else np.array(hist[-1]))
+                    message = (f"limit cycle by cohorts: cycles {it - 2}-{it} (of {it}) give sigma_max and "
+                               f"sigma_min to {error:.1e} ({'Aitken' if 2.0 * change == error else 'last step'})")
                     break
             previous = extrapolated
     else:

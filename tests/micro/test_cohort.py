@@ -14,7 +14,7 @@ import pytest
 
 import micro
 from micro import _cohort_kernels as CK
-from micro.cohort import _start, cycle_cohorts
+from micro.cohort import _NO_COARSE, _start, cycle_cohorts
 
 
 def test_state_after_a_total_shock_has_branching_ratio_one_minus_k0_over_kappa():
@@ -57,10 +57,13 @@ def test_cohort_cycle_matches_the_fokker_planck_solvers_and_the_exact_sigma_min(
     assert abs(res.sigma_min - micro.sigma_fast_limit(model)) < 1e-4
     assert 0.95934 - 3e-4 < res.sigma_max < 0.95963 + 3e-4
     assert res.error <= 1e-4
-    # the starting marginal is the previous fixed point: fewer cycles
+    # started from the fixed point, the first cycle is on it (from the first shock's
+    # image, without the coarser run, it is 1e-2 away)
     again = cycle_cohorts(model, 2.403, dt=0.02, h=0.01, tol=1e-4, start=res)
-    assert again.iterations < res.iterations
+    assert abs(again.history[0, 0] - res.sigma_max) < 2e-4
     assert again.sigma_max == pytest.approx(res.sigma_max, abs=2e-4)
+    cold = cycle_cohorts(model, 2.403, dt=0.02, h=0.01, tol=1e-4, max_iter=4, start=_NO_COARSE)
+    assert abs(cold.history[0, 0] - res.sigma_max) > 5e-3
 
 
 def test_cycle_sequence_is_smooth_at_small_k0():
@@ -68,7 +71,7 @@ def test_cycle_sequence_is_smooth_at_small_k0():
     a steady contraction ratio (the shock-to-shock map on the grid jitters by ~k0 eps
     there): what makes the Aitken extrapolation valid."""
     model = micro.Model(k0=0.001)
-    res = cycle_cohorts(model, 24.27, dt=0.02, h=0.01, tol=1e-9, max_iter=10)
+    res = cycle_cohorts(model, 24.27, dt=0.02, h=0.01, tol=1e-9, max_iter=10, start=_NO_COARSE)
     d = np.diff(res.history[:, 0])
     assert np.all(d < 0.0), d
     rho = d[1:] / d[:-1]
