@@ -1,6 +1,7 @@
 """Refinement study of the cohort method (``micro.cohort``), run time against error.
 
-Points: Fig. 4 parameters, V = 0.3 V^c, k0 = 1e-2, 1e-3 and 1e-4.  The two refinement
+Points: Fig. 4 parameters, V = 0.3 V^c, k0 = 0.3, 0.1, 1e-2, 1e-3 and 1e-4 (the five of the
+paper's Fig. 10).  The two refinement
 variables, the time step dt and the delta_R cell h, are halved together from
 (0.02, 0.01) to (0.005, 0.0025); each level starts from the previous level's fixed point
 and is converged to tol = 1e-6 (Aitken's extrapolation of the cycles).  The order p
@@ -9,9 +10,10 @@ has an exact limit, f_th - kappa zbar: the check of the procedure.  Each row's
 "distance" is its distance from the extrapolated limit: the error that its run time
 bought.
 
-Writes benchmarks/results/micro_cohort_refinement.csv.
+Writes benchmarks/results/micro_cohort_refinement.csv (rows merge by k0, dt and h, so a
+run with ``--k0 0.3`` alone adds that k0).
 
-    python benchmarks/micro_cohort_refinement.py        # about 10 minutes on 1 core
+    python benchmarks/micro_cohort_refinement.py        # about 20 minutes on 1 core
 """
 from __future__ import annotations
 
@@ -41,7 +43,7 @@ def order_and_limit(s: np.ndarray) -> tuple[float, float]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--k0", default="0.01,0.001,0.0001")
+    ap.add_argument("--k0", default="0.3,0.1,0.01,0.001,0.0001")
     ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_refinement.csv"))
     args = ap.parse_args()
     rows = []
@@ -60,6 +62,11 @@ def main() -> None:
                              cycles=res.iterations, converged=res.converged, wall_s=wall))
             print(rows[-1], flush=True)
     frame = pd.DataFrame(rows)
+    if Path(args.out).exists():
+        old = pd.read_csv(args.out)[list(frame.columns)]
+        old = old[~old.set_index(["k0", "dt", "h"]).index.isin(frame.set_index(["k0", "dt", "h"]).index)]
+        frame = pd.concat([old, frame], ignore_index=True).sort_values(["k0", "dt"], ascending=[False, False])
+        frame = frame.reset_index(drop=True)
     for k0, grp in frame.groupby("k0", sort=False):
         for col in ("sigma_max", "sigma_min"):
             p, lim = order_and_limit(grp[col].to_numpy())

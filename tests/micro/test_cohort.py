@@ -105,3 +105,17 @@ def test_cohort_rejects_bad_input():
             cycle_cohorts(micro.Model(k0=0.01), 1.0, **kwargs)
     with pytest.raises(ValueError, match="method"):
         micro.stationary(micro.Model(k0=0.01), 1.0, method="cohorts")
+
+
+def test_cli_sweep_method_cohort(tmp_path):
+    """``micro sweep --method cohort`` writes the sweep's columns; ``--eps`` is its cell."""
+    import pandas as pd
+
+    from micro.cli import main
+
+    out = tmp_path / "cohort.csv"
+    assert main(["sweep", "--k0", "0.001", "--V", "20", "--method", "cohort", "--eps", "0.01", "--out", str(out)]) == 0
+    row = pd.read_csv(out).iloc[0]
+    assert row.regime == "stick-slip" and bool(row.converged) and row.eps == 0.01
+    assert abs(row.sigma_min - micro.sigma_fast_limit(micro.Model(k0=0.001))) < 1e-4
+    assert row.sigma_max > row.sigma_mean > row.sigma_min and row.period > 0
