@@ -1,7 +1,7 @@
 """Refinement study of the cohort method (``micro.cohort``), run time against error.
 
-Points: Fig. 4 parameters, V = 0.3 V^c, k0 = 0.3, 0.1, 1e-2, 1e-3 and 1e-4 (the five of the
-paper's Fig. 10).  The two refinement
+Points: Fig. 4 parameters, k0 = 0.3, 0.1, 1e-2, 1e-3 and 1e-4 (the five of the paper's
+Fig. 10), V = 0.3 V^c (``--fraction`` sets V / V^c).  The two refinement
 variables, the time step dt and the delta_R cell h, are halved together from
 (0.02, 0.01) to (0.005, 0.0025); each level starts from the previous level's fixed point
 and is converged to tol = 1e-6 (Aitken's extrapolation of the cycles).  The order p
@@ -10,8 +10,8 @@ has an exact limit, f_th - kappa zbar: the check of the procedure.  Each row's
 "distance" is its distance from the extrapolated limit: the error that its run time
 bought.
 
-Writes benchmarks/results/micro_cohort_refinement.csv (rows merge by k0, dt and h, so a
-run with ``--k0 0.3`` alone adds that k0).
+Writes benchmarks/results/micro_cohort_refinement.csv (rows merge by k0, V / V^c, dt and
+h, so a run with ``--k0 0.3 --fraction 0.5`` alone adds those rows).
 
     python benchmarks/micro_cohort_refinement.py        # about 20 minutes on 1 core
 """
@@ -44,30 +44,33 @@ def order_and_limit(s: np.ndarray) -> tuple[float, float]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--k0", default="0.3,0.1,0.01,0.001,0.0001")
+    ap.add_argument("--fraction", type=float, default=0.3, help="V / V^c")
     ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_refinement.csv"))
     args = ap.parse_args()
     rows = []
     cycle_cohorts(micro.Model(k0=0.01), 2.4, dt=0.05, h=0.02, tol=1e-2, max_iter=4)  # compile
     for k0 in (float(v) for v in args.k0.split(",")):
         model = micro.Model(k0=k0)
-        V = 0.3 * micro.critical_velocity(model).Vc
+        V = args.fraction * micro.critical_velocity(model).Vc
         start = None
         for dt, h in LEVELS:
             t = time.perf_counter()
             res = cycle_cohorts(model, V, dt=dt, h=h, tol=1e-6, start=start)
             wall = time.perf_counter() - t
             start = res
-            rows.append(dict(k0=k0, V=V, dt=dt, h=h, sigma_max=res.sigma_max, sigma_min=res.sigma_min,
+            rows.append(dict(k0=k0, V_over_Vc=args.fraction, V=V, dt=dt, h=h, sigma_max=res.sigma_max, sigma_min=res.sigma_min,
                              exact_sigma_min=micro.sigma_fast_limit(model), period=res.period, error=res.error,
                              cycles=res.iterations, converged=res.converged, wall_s=wall))
             print(rows[-1], flush=True)
     frame = pd.DataFrame(rows)
     if Path(args.out).exists():
         old = pd.read_csv(args.out)[list(frame.columns)]
-        old = old[~old.set_index(["k0", "dt", "h"]).index.isin(frame.set_index(["k0", "dt", "h"]).index)]
-        frame = pd.concat([old, frame], ignore_index=True).sort_values(["k0", "dt"], ascending=[False, False])
+        key = ["k0", "V_over_Vc", "dt", "h"]
+        old = old[~old.set_index(key).index.isin(frame.set_index(key).index)]
+        frame = pd.concat([old, frame], ignore_index=True).sort_values(["k0", "V_over_Vc", "dt"],
+                                                                      ascending=[False, True, False])
         frame = frame.reset_index(drop=True)
-    for k0, grp in frame.groupby("k0", sort=False):
+    for _, grp in frame.groupby(["k0", "V_over_Vc"], sort=False):
         for col in ("sigma_max", "sigma_min"):
             p, lim = order_and_limit(grp[col].to_numpy())
             frame.loc[grp.index, f"{col}_order"] = p

@@ -49,7 +49,7 @@ log = logging.getLogger(__name__)
 _GX, _GW = np.polynomial.legendre.leggauss(2)
 _GX, _GW = 0.5 * _GX + 0.5, 0.5 * _GW
 #: Cohorts whose surviving mass is below this are dropped.
-SURVIVOR_FLOOR = 1e-17
+SURVIVOR_FLOOR = 1e-15
 #: The start of a shock is located to this fraction of the time step.
 FOLD_TOL = 1e-7
 #: Most cells the cohorts may hold (about 50 MB).
@@ -266,8 +266,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     The sequence of cycle extrema converges geometrically; the result is Aitken's
     extrapolation of the last three cycles, stopped when two consecutive extrapolations
     of sigma_max and sigma_min agree to ``tol / 2`` with a contraction ratio in [0, 0.95]
-    (``error`` is twice that change), or the last cycle when it moved by less than
-    ``tol / STILL`` (``error`` is STILL times that step).  It is the error of the fixed point at this ``dt`` and
+    (``error`` is twice that change), or the last cycle when the cycles agree to
+    ``tol / 100`` (``error`` is STILL times the last step); a sequence that contracts
+    slowly (ratio above 0.95) is given the error ``step / (1 - ratio)``.  It is the error of the fixed point at this ``dt`` and
     ``h``, not their discretisation error (``h`` defaults to ``kappa zbar / 20``).
     ``eps`` in the result is ``h``.
     """
@@ -314,15 +315,21 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             step = max(abs(hist[-1][i] - hist[-2][i]) for i in (0, 1))
             if previous is not None:
                 change = float(np.max(np.abs(extrapolated[:2] - previous[:2])))
-                ok_ratio = bool(np.all((rho[:2] >= 0.0) & (rho[:2] <= 0.95)))
-                # Aitken's estimate while the differences contract steadily; once the cycles
-                # agree to round-off the ratios are noise, and the last step (times the
-                # tail of a contraction by 0.8) bounds the error
-                error = min(2.0 * change if ok_ratio else math.inf, STILL * step)
+                rho_max = float(np.max(rho[:2]))
+                if np.all(rho[:2] >= 0.0) and rho_max <= 0.95:
+                    # the differences contract steadily: Aitken's estimate
+                    error, how, best = 2.0 * change, "Aitken", extrapolated
+                elif step <= tol / 100.0:
+                    # the cycles agree to round-off, where the ratios are noise: the last
+                    # step times the tail of a contraction by 0.8
+                    error, how, best = STILL * step, "last step", np.array(hist[-1])
+                else:
+                    # slow (ratio near 1) or irregular: the tail of a contraction by rho_max
+                    error, how, best = step / max(1.0 - rho_max, 1e-3), "slow", np.array(hist[-1])
                 if error <= tol:
-                    converged, value = True, (extrapolated if 2.0 * change == error else np.array(hist[-1]))
+                    converged, value = True, best
                     message = (f"limit cycle by cohorts: cycles {it - 2}-{it} (of {it}) give sigma_max and "
-                               f"sigma_min to {error:.1e} ({'Aitken' if 2.0 * change == error else 'last step'})")
+                               f"sigma_min to {error:.1e} ({how})")
                     break
             previous = extrapolated
     else:
