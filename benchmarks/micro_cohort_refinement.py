@@ -4,7 +4,7 @@ Points: Fig. 4 parameters, k0 = 0.3, 0.1, 1e-2, 1e-3 and 1e-4 (the five of the p
 Fig. 10), V = 0.3 V^c (``--fraction`` sets V / V^c).  The two refinement
 variables, the time step dt and the delta_R cell h, are halved together from
 (0.02, 0.01) to (0.005, 0.0025); each level starts from the previous level's fixed point
-and is converged to tol = 1e-6 (Aitken's extrapolation of the cycles).  The order p
+and is converged to tol = 1e-6 (``--tol``; Aitken's extrapolation of the cycles).  The order p
 and the limit come from the three levels (sigma(l) = sigma_0 + C 2^(-p l)); sigma_min
 has an exact limit, f_th - kappa zbar: the check of the procedure.  Each row's
 "distance" is its distance from the extrapolated limit: the error that its run time
@@ -45,6 +45,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--k0", default="0.3,0.1,0.01,0.001,0.0001")
     ap.add_argument("--fraction", type=float, default=0.3, help="V / V^c")
+    ap.add_argument("--tol", type=float, default=1e-6, help="each level's fixed point to this")
     ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_refinement.csv"))
     args = ap.parse_args()
     rows = []
@@ -55,7 +56,7 @@ def main() -> None:
         start = None
         for dt, h in LEVELS:
             t = time.perf_counter()
-            res = cycle_cohorts(model, V, dt=dt, h=h, tol=1e-6, start=start)
+            res = cycle_cohorts(model, V, dt=dt, h=h, tol=args.tol, start=start)
             wall = time.perf_counter() - t
             start = res
             rows.append(dict(k0=k0, V_over_Vc=args.fraction, V=V, dt=dt, h=h, sigma_max=res.sigma_max, sigma_min=res.sigma_min,

@@ -72,6 +72,7 @@ def test_stop_inside_a_shock_is_the_same_run():
     assert sa[:, 3].sum() > 10 * sb[0, 3]  # the whole shock is much longer
 
 
+@pytest.mark.slow  # (the map is superseded by the cohort method, tests/micro/test_cohort.py)
 def test_cycle_agrees_with_time_stepping_and_the_exact_minimum():
     """At k0 = 0.01, V = 0.3 V^c and the method's default bin kappa zbar / 8, the fixed
     point of the map and the time-stepped limit cycle (which time-steps its shocks)
@@ -151,9 +152,11 @@ def test_cycle_declines_shocks_that_are_not_total_near_vc():
     assert not near.applicable and not near.converged and "not a total shock" in near.message
     far = cycle_fixed_point(MODEL, 0.9 * vc, 0.0125, tol=1e-4)
     assert far.applicable and far.converged and far.unjumped < 1e-6
-    assert 0.02 < far.sigma_max - far.sigma_min < 0.03
+    # (its amplitude there, 0.026, is the grid's: the N-block and the cohort method give
+    # 0.015, docs/reference/micro_cycle.md; tests/micro/test_cohort.py checks that)
 
 
+@pytest.mark.slow  # (the map is superseded by the cohort method, tests/micro/test_cohort.py)
 def test_sweep_continues_the_map_from_the_previous_row():
     """``sweep(method="cycle")`` starts each row from the previous row's fixed point: the
     second row needs fewer cycles than from the first shock's image, and gives the same
