@@ -52,6 +52,8 @@ _GX, _GW = 0.5 * _GX + 0.5, 0.5 * _GW
 SURVIVOR_FLOOR = 1e-15
 #: The start of a shock is located to this fraction of the time step.
 FOLD_TOL = 1e-7
+#: The time step is cut so that a loading phase has at least this many steps.
+STEPS_PER_CYCLE = 50
 #: Most cells the cohorts may hold (about 50 MB).
 MAX_CELLS = 3_000_000
 #: A last step d between cycles leaves at most STILL * d to go when they contract by 0.8 a cycle.
@@ -267,9 +269,11 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     extrapolation of the last three cycles, stopped when two consecutive extrapolations
     of sigma_max and sigma_min agree to ``tol / 2`` with a contraction ratio in [0, 0.95]
     (``error`` is twice that change), or the last cycle when the cycles agree to
-    ``tol / 100`` (``error`` is STILL times the last step); a sequence that contracts
-    slowly (ratio above 0.95) is given the error ``step / (1 - ratio)``.  It is the error of the fixed point at this ``dt`` and
-    ``h``, not their discretisation error (``h`` defaults to ``kappa zbar / 20``).
+    ``tol / 100`` or alternate by less than ``tol / STILL`` (``error`` is STILL times the
+    last steps); a sequence that contracts slowly (ratio above 0.95) is given the error
+    ``step / (1 - ratio)``.  It is the error of the fixed point at this ``dt`` and
+    ``h``, not their discretisation error (``h`` defaults to ``kappa zbar / 20``).  ``dt``
+    is cut to a fiftieth of the loading phase where that is shorter (close to V^c).
     ``eps`` in the result is ``h``.
     """
     begin = time.perf_counter()
@@ -308,21 +312,32 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if st.outside > 1e-12:
             message = f"the delta_R marginal left the nodes ({st.outside:.2g} of the mass)"
             break
+        if not out["period"] > 1e-9:
+            applicable, message = False, "a shock started with no loading phase (the state is past its fold)"
+            break
+        if out["period"] < STEPS_PER_CYCLE * dt:
+            # close to V^c the loading phase is short: resolve it with STEPS_PER_CYCLE
+            # steps, and start the sequence again at the new step
+            dt = out["period"] / STEPS_PER_CYCLE
+            hist.clear()
+            previous = None
+            continue
         hist.append((out["sigma_max"], out["sigma_min"], out["period"], out["sigma_mean"]))
         log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f", it, out["sigma_max"], out["sigma_min"])
         if len(hist) >= 3:
             extrapolated, rho = _aitken(np.array(hist))
             step = max(abs(hist[-1][i] - hist[-2][i]) for i in (0, 1))
+            last_two = max(step, max(abs(hist[-2][i] - hist[-3][i]) for i in (0, 1)))
             if previous is not None:
                 change = float(np.max(np.abs(extrapolated[:2] - previous[:2])))
                 rho_max = float(np.max(rho[:2]))
                 if np.all(rho[:2] >= 0.0) and rho_max <= 0.95:
                     # the differences contract steadily: Aitken's estimate
                     error, how, best = 2.0 * change, "Aitken", extrapolated
-                elif step <= tol / 100.0:
-                    # the cycles agree to round-off, where the ratios are noise: the last
-                    # step times the tail of a contraction by 0.8
-                    error, how, best = STILL * step, "last step", np.array(hist[-1])
+                elif step <= tol / 100.0 or (np.any(rho[:2] < 0.0) and last_two <= tol / STILL):
+                    # the cycles agree to round-off, or alternate (noise, not a drift) by
+                    # little: the last steps times the tail of a contraction by 0.8
+                    error, how, best = STILL * max(step, last_two), "last steps", np.array(hist[-1])
                 else:
                     # slow (ratio near 1) or irregular: the tail of a contraction by rho_max
                     error, how, best = step / max(1.0 - rho_max, 1e-3), "slow", np.array(hist[-1])
