@@ -2,14 +2,17 @@
 
 Layout: cohort ``c`` has scalars (birth time ``t0``, mean slip ``X0`` and stress ``s0`` at
 birth, the dashpot integral ``J``), and ``nn[c]`` cells of width ``h`` in delta_R starting
-at node ``j0[c]``, stored from ``off[c]``: cell ``k`` keeps the density ``q`` and the floor
-``m`` (in units of the margin at birth) at both of its ends, at ``2 (off + k)`` and
-``2 (off + k) + 1``.  ``co[c]`` holds the step's coefficients: beta, the threshold ``D``
+at node ``j0[c]``, stored from ``off[c]``: cell ``k`` keeps the density ``q`` at both of its
+ends (at ``2 (off + k)`` and ``2 (off + k) + 1``) and its floor ``m`` (in units of the margin
+at birth), piecewise linear with at most one kink: at ``4 (off + k)`` the values at the
+two ends, the kink's position (local coordinate; 1 when there is none) and the value
+there.  ``co[c]`` holds the step's coefficients: beta, the threshold ``D``
 at delta_R = 0, dD/d(delta_R), dD/d(dX), exp(-gamma age), and the smallest gap between
 floor and threshold at dX = 0 (cohorts that cannot cross are skipped).
 """
 import math
 
+import numpy as np
 from numba import njit
 
 @njit(cache=True)
@@ -40,8 +43,9 @@ def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, 
         o = off[c]
         for k in range(nn[c]):
             d0 = co[c, 1] + co[c, 2] * (ylo + (j0[c] + k) * h)
-            i2 = 2 * (o + k)
-            g = min(m[i2] - d0, m[i2 + 1] - d0 - co[c, 2] * h)
+            i4 = 4 * (o + k)
+            dh = co[c, 2] * h
+            g = min(m[i4] - d0, m[i4 + 1] - d0 - dh, m[i4 + 3] - d0 - dh * m[i4 + 2])
             if g < gap:
                 gap = g
         co[c, 5] = gap
@@ -65,17 +69,57 @@ def _isub(q0, q1, m0, m1, a, b, lam):
 
 
 @njit(cache=True)
-def _cell_range(d0, d1, ma, mb):
-    """The part [a, b] of a cell (local coordinate 0..1) where the threshold D is above
-    the floor (both linear); (-1, -1) if none."""
-    g0 = d0 - ma; g1 = d1 - mb
-    if g0 <= 0.0 and g1 <= 0.0:
+def _piece(m, i4, p):
+    """Piece ``p`` (0: before the kink, 1: after it) of a cell's floor: its range [lo, hi]
+    and the floor's line there, as its values at the cell's ends (0 and 1); lo == hi if
+    the piece is empty."""
+    m0 = m[i4]; m1 = m[i4 + 1]; sk = m[i4 + 2]; mk = m[i4 + 3]
+    if p == 0:
+        if sk <= 0.0:
+            return 0.0, 0.0, m0, m0
+        slope = (mk - m0) / sk
+        return 0.0, sk, m0, m0 + slope
+    if sk >= 1.0:
+        return 1.0, 1.0, m1, m1
+    slope = (m1 - mk) / (1.0 - sk)
+    return sk, 1.0, m1 - slope, m1
+
+
+@njit(cache=True)
+def _piece_range(d0, d1, f0, f1, lo, hi):
+    """The part [a, b] of [lo, hi] where the threshold (d0 -> d1 over the cell) is above the
+    floor's line (f0 -> f1); (-1, -1) if none."""
+    if hi <= lo:
         return -1.0, -1.0
-    if g0 > 0.0 and g1 > 0.0:
-        return 0.0, 1.0
-    if g0 > 0.0:
-        return 0.0, g0 / (g0 - g1)
-    return g0 / (g0 - g1), 1.0
+    gl = (d0 - f0) + ((d1 - f1) - (d0 - f0)) * lo
+    gh = (d0 - f0) + ((d1 - f1) - (d0 - f0)) * hi
+    if gl <= 0.0 and gh <= 0.0:
+        return -1.0, -1.0
+    if gl > 0.0 and gh > 0.0:
+        return lo, hi
+    sc = lo + (hi - lo) * gl / (gl - gh)
+    if gl > 0.0:
+        return lo, sc
+    return sc, hi
+
+
+@njit(cache=True)
+def _floor_at(m, i4, s):
+    """A cell's floor at local coordinate ``s``."""
+    sk = m[i4 + 2]
+    if s <= sk:
+        return m[i4] + (m[i4 + 3] - m[i4]) * (s / sk) if sk > 0.0 else m[i4 + 3]
+    return m[i4 + 3] + (m[i4 + 1] - m[i4 + 3]) * ((s - sk) / (1.0 - sk))
+
+
+@njit(cache=True)
+def _survivors_cell(q0, q1, m, i4, lam):
+    S = 0.0
+    for p in range(2):
+        lo, hi, f0, f1 = _piece(m, i4, p)
+        if hi > lo:
+            S += _isub(q0, q1, f0, f1, lo, hi, lam)
+    return S
 
 
 @njit(cache=True)
@@ -98,27 +142,29 @@ def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw):
             y0 = ylo + (j0[c] + k) * h
             d0 = Da + Dy * y0; d1 = d0 + Dy * h
             i2 = 2 * (o + k)
-            ma = m[i2]; mb = m[i2 + 1]
-            a, b = _cell_range(d0, d1, ma, mb)
-            if a < 0.0:
-                continue
+            i4 = 4 * (o + k)
             q0 = q[i2]; q1 = q[i2 + 1]
-            # first crossings, exact
-            cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
-            dcross = _isub(q0, q1, d0, d1, a, b, lam) / lam
-            rej = 0.0
-            L = (b - a)
-            for i in range(gx.size):
-                s = a + L * gx[i]
-                qv = q0 + (q1 - q0) * s
-                mv = ma + (mb - ma) * s
-                Dv = d0 + (d1 - d0) * s
-                em = math.exp(-mv / lam); eD = math.exp(-Dv / lam)
-                rej += gw[i] * qv * ((Dv - mv) * em - lam * (em - eD))
-            rej *= L * beta / lam
-            drej = beta / lam * (cross)
-            N += h * (cross + rej)
-            dN += h * (dcross + drej) * D1
+            for p in range(2):
+                lo, hi, ma, mb = _piece(m, i4, p)
+                a, b = _piece_range(d0, d1, ma, mb, lo, hi)
+                if a < 0.0:
+                    continue
+                # first crossings, exact
+                cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
+                dcross = _isub(q0, q1, d0, d1, a, b, lam) / lam
+                rej = 0.0
+                L = (b - a)
+                for i in range(gx.size):
+                    s = a + L * gx[i]
+                    qv = q0 + (q1 - q0) * s
+                    mv = ma + (mb - ma) * s
+                    Dv = d0 + (d1 - d0) * s
+                    em = math.exp(-mv / lam); eD = math.exp(-Dv / lam)
+                    rej += gw[i] * qv * ((Dv - mv) * em - lam * (em - eD))
+                rej *= L * beta / lam
+                drej = beta / lam * (cross)
+                N += h * (cross + rej)
+                dN += h * (dcross + drej) * D1
     return zbar * N - dX, zbar * dN - 1.0
 
 
@@ -223,8 +269,9 @@ def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2
     """Apply a step of slip ``dX``: the crossed members' delta_R (a linear function of
     their margin at birth, so an exponential on a segment) is deposited exactly on the
     hat functions of the nodes ``ylo + j h`` (``dep``: the newborn cohort, margins
-    Exp(lam) after their re-jumps); a crossed cell part gets a new floor, a line whose
-    survivor mass is exact.  Returns the mass that fell outside the nodes."""
+    Exp(lam) after their re-jumps); a crossed cell gets the new floor, the larger of
+    the old floor and the threshold (:func:`_new_floor`).  Returns the mass that fell
+    outside the nodes."""
     r2 = k2 / kappa
     ny = dep.size
     bad = 0.0
@@ -241,14 +288,20 @@ def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2
             y0 = ylo + (j0[c] + k) * h
             d0 = Da + Dy * y0; d1 = d0 + Dy * h
             i2 = 2 * (o + k)
-            ma = m[i2]; mb = m[i2 + 1]
-            a, b = _cell_range(d0, d1, ma, mb)
-            if a < 0.0:
-                continue
+            i4 = 4 * (o + k)
             q0 = q[i2]; q1 = q[i2 + 1]
-            S_old = _isub(q0, q1, ma, mb, 0.0, 1.0, lam)
-            cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
-            if cross > 0.0:
+            crossed = False
+            cross_total = 0.0
+            for p in range(2):
+                lo, hi, ma, mb = _piece(m, i4, p)
+                a, b = _piece_range(d0, d1, ma, mb, lo, hi)
+                if a < 0.0:
+                    continue
+                crossed = True
+                cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
+                if cross <= 0.0:
+                    continue
+                cross_total += cross
                 # newborns at the Gauss points, scaled to the exact crossed mass
                 L = b - a
                 tot = 0.0
@@ -273,19 +326,71 @@ def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2
                     Btil = r2 * (1.0 - E)
                     Atil = yv * E + r2 * (1.0 - E) * (f_th - s0[c] + yv) + k2 * Jn
                     bad += deposit(dep, mass, Atil - Btil * mv, Btil, Dv - mv, lam, ylo, h)
-            # the new floor: a line in the cell with the exact survivor mass
-            if a == 0.0 and b == 1.0:
-                m[i2] = d0; m[i2 + 1] = d1
-            else:
-                S_new = S_old - cross
-                na = max(ma, d0); nb_ = max(mb, d1)
-                S_chord = _isub(q0, q1, na, nb_, 0.0, 1.0, lam)
-                if S_new > 0.0 and S_chord > 0.0:
-                    shift = -lam * math.log(S_new / S_chord)
-                else:
-                    shift = 0.0
-                m[i2] = na + shift; m[i2 + 1] = nb_ + shift
+            if crossed:
+                _new_floor(m, i4, d0, d1, q0, q1, cross_total, lam)
     return bad
+
+
+@njit(cache=True)
+def _new_floor(m, i4, d0, d1, q0, q1, crossed, lam):
+    """Replace a cell's floor by max(floor, threshold).  That is piecewise linear; where it
+    has at most one kink (the threshold overtaking a floor, the usual case) it is stored
+    exactly; otherwise the kink farthest from the chord is kept and the floor shifted so
+    that the surviving mass is exact."""
+    S_exact = _survivors_cell(q0, q1, m, i4, lam) - crossed
+    pts = np.empty(6)
+    npt = 0
+    pts[npt] = 0.0; npt += 1
+    sk = m[i4 + 2]
+    if 0.0 < sk < 1.0:
+        pts[npt] = sk; npt += 1
+    for p in range(2):
+        lo, hi, f0, f1 = _piece(m, i4, p)
+        if hi <= lo:
+            continue
+        gl = (d0 - f0) + ((d1 - f1) - (d0 - f0)) * lo
+        gh = (d0 - f0) + ((d1 - f1) - (d0 - f0)) * hi
+        if (gl > 0.0) != (gh > 0.0) and gl != gh:
+            sc = lo + (hi - lo) * gl / (gl - gh)
+            if lo < sc < hi:
+                pts[npt] = sc; npt += 1
+    pts[npt] = 1.0; npt += 1
+    x = np.sort(pts[:npt])
+    v = np.empty(npt)
+    for i in range(npt):
+        v[i] = max(_floor_at(m, i4, x[i]), d0 + (d1 - d0) * x[i])
+    # drop interior points on the line of their neighbours, and points too close to an end
+    keep = np.ones(npt, dtype=np.bool_)
+    prev = 0
+    for i in range(1, npt - 1):
+        nxt = i + 1
+        w = (x[i] - x[prev]) / (x[nxt] - x[prev]) if x[nxt] > x[prev] else 0.0
+        line = v[prev] + (v[nxt] - v[prev]) * w
+        if abs(v[i] - line) <= 1e-13 * (1.0 + abs(v[i])) or x[i] < 1e-9 or x[i] > 1.0 - 1e-9:
+            keep[i] = False
+        else:
+            prev = i
+    xi = x[keep]
+    vi = v[keep]
+    m[i4] = vi[0]
+    m[i4 + 1] = vi[-1]
+    if xi.size == 2:
+        m[i4 + 2] = 1.0
+        m[i4 + 3] = vi[-1]
+        return
+    # the interior point farthest from the chord is the kink
+    best, dev = 1, -1.0
+    for i in range(1, xi.size - 1):
+        d = abs(vi[i] - (vi[0] + (vi[-1] - vi[0]) * xi[i]))
+        if d > dev:
+            best, dev = i, d
+    m[i4 + 2] = xi[best]
+    m[i4 + 3] = vi[best]
+    if xi.size > 3:
+        S = _survivors_cell(q0, q1, m, i4, lam)
+        if S > 0.0 and S_exact > 0.0:
+            shift = -lam * math.log(S_exact / S)
+            m[i4] += shift; m[i4 + 1] += shift; m[i4 + 3] += shift
 
 
 @njit(cache=True)
@@ -296,5 +401,5 @@ def survivors(n, j0, nn, off, q, m, h, lam, out):
         s = 0.0
         for k in range(nn[c]):
             i2 = 2 * (o + k)
-            s += _isub(q[i2], q[i2 + 1], m[i2], m[i2 + 1], 0.0, 1.0, lam)
+            s += _survivors_cell(q[i2], q[i2 + 1], m, 4 * (o + k), lam)
         out[c] = s * h

@@ -75,7 +75,7 @@ class _Cohorts:
         self.t0, self.X0, self.s0, self.J = (np.zeros(cap) for _ in range(4))
         self.j0, self.nn, self.off = (np.zeros(cap, np.int64) for _ in range(3))
         self.co = np.zeros((cap, 6))
-        self.q, self.m = np.zeros(1 << 16), np.zeros(1 << 16)
+        self.q, self.m = np.zeros(1 << 16), np.zeros(1 << 17)
         self.n = self.pool = 0
         self.t = self.X = self.sigma = 0.0
         self.last = 0.0
@@ -89,24 +89,25 @@ class _Cohorts:
             return
         a, b = max(idx[0] - 1, 0), min(idx[-1] + 2, self.ny)  # a node of zero density at each end
         cells = b - a - 1
-        if self.n + 1 > self.t0.size or 2 * (self.pool + cells) > self.q.size:
+        if self.n + 1 > self.t0.size or 2 * (self.pool + cells) > self.q.size or 4 * (self.pool + cells) > self.m.size:
             self.compact()
             if self.n + 1 > self.t0.size:
                 for name in ("t0", "X0", "s0", "J", "j0", "nn", "off"):
                     old = getattr(self, name)
                     setattr(self, name, np.concatenate([old, np.zeros_like(old)]))
                 self.co = np.zeros((self.t0.size, 6))
-            if 2 * (self.pool + cells) > self.q.size:
+            if 2 * (self.pool + cells) > self.q.size or 4 * (self.pool + cells) > self.m.size:
                 extra = self.q.size + 2 * cells
                 self.q = np.concatenate([self.q, np.zeros(extra)])
-                self.m = np.concatenate([self.m, np.zeros(extra)])
+                self.m = np.concatenate([self.m, np.zeros(2 * extra)])
         c, p = self.n, self.pool
         self.t0[c], self.X0[c], self.s0[c], self.J[c] = self.t, self.X, self.sigma, 0.0
         self.j0[c], self.nn[c], self.off[c] = a, cells, p
         nodes = dep[a:b] / self.h
         self.q[2 * p:2 * (p + cells):2] = nodes[:-1]
         self.q[2 * p + 1:2 * (p + cells):2] = nodes[1:]
-        self.m[2 * p:2 * (p + cells)] = 0.0
+        floors = self.m[4 * p:4 * (p + cells)].reshape(cells, 4)
+        floors[:] = (0.0, 0.0, 1.0, 0.0)  # (ends, no kink)
         self.pool += cells
         self.n += 1
 
@@ -123,7 +124,7 @@ class _Cohorts:
         for i, c in enumerate(keep):
             k, o = self.nn[c], self.off[c]
             q[2 * p:2 * (p + k)] = self.q[2 * o:2 * (o + k)]
-            m[2 * p:2 * (p + k)] = self.m[2 * o:2 * (o + k)]
+            m[4 * p:4 * (p + k)] = self.m[4 * o:4 * (o + k)]
             for name in ("t0", "X0", "s0", "J", "j0", "nn"):
                 getattr(self, name)[i] = getattr(self, name)[c]
             self.off[i] = p
