@@ -1,6 +1,6 @@
-r"""Stick-slip cycles with total global shocks: the loading phase as cohorts of exponential margins.
+r"""Stick-slip cycles by cohorts of exponential margins: no grid in the margin.
 
-A grid-free solver of the mean-field dynamics (docs/reference/micro_cycle.md §6).  Between
+A grid-free solver of the mean-field dynamics (docs/reference/micro_cohort.md).  Between
 its own jumps a block's margin is linear in its state at its last jump, with
 coefficients common to all blocks born at the same time:
 
@@ -14,8 +14,8 @@ rest.  So the blocks born in one step (a *cohort*) are Exp(kappa zbar) in
 :math:`\delta'` times a density in :math:`\delta_R'`, and the members that have not
 jumped again are those above a floor :math:`\delta' > m(\delta_R')`.  Nothing is
 discretised in the margin: a cohort's density is piecewise linear on cells of width
-``h`` in delta_R, each cell with a linear floor, and every crossed mass is an exact
-integral of an exponential.  A step of length ``dt`` solves the mean-field closure for its
+``h`` in delta_R, each cell with a floor that is linear or has one kink, and every
+crossed mass is an exact integral of an exponential.  A step of length ``dt`` solves the mean-field closure for its
 slip (``dX = zbar x`` the jumps it causes, a crossed block jumping again as a Poisson
 process of its overshoot); the loading phase ends where the closure's smallest root
 jumps (a fold), located by bisecting the step; the shock is the same closure in zero
@@ -24,8 +24,8 @@ the state, so the cycle-to-cycle sequence converges smoothly (geometrically, by 
 0.8 per cycle) and is extrapolated by Aitken's method.
 
 Shocks need not be total: the blocks a shock leaves unjumped stay in their cohorts
-with raised floors (at k0 = 0.1 and 0.3 they survive several cycles, and the cost per
-cycle grows with them).  Refinement variables: the time step ``dt`` and the cell width
+with raised floors (at k0 = 0.1 and 0.3 their cohorts live for many cycles, and the
+cost per cycle grows with them).  Refinement variables: the time step ``dt`` and the cell width
 ``h`` (measured orders in benchmarks/micro_cohort_refinement.py).  Needs exponential
 jumps, and a loading phase that ends in a shock within ``20 kappa zbar / (k0 V)``
 (otherwise ``applicable=False``).
@@ -68,7 +68,7 @@ class _Cohorts:
     def __init__(self, model: Model, V: float, h: float) -> None:
         self.model, self.V, self.h = model, V, h
         self.lam = model.kappa * model.zbar
-        # delta_R lies within (k2 / kappa) * 40 lam of 0 for all but 1e-17 of the mass
+        # delta_R lies within (k2 / kappa) * 40 lam of 0 for all but ~1e-17 of the mass
         half = int(math.ceil(45.0 * model.k2 * model.zbar / h)) + 8
         self.ylo, self.ny = -half * h, 2 * half
         cap = 1024
@@ -240,7 +240,11 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     st.prepare(0.0)
     x, _ = st.root()
     n_old = st.n
-    st.commit(st.shock_root(max(x, 1e-12 * st.model.zbar)), 0.0, 0.0, 1.0)
+    try:
+        slip = st.shock_root(max(x, 1e-12 * st.model.zbar))
+    except RuntimeError as err:
+        return dict(ok=False, message=str(err))
+    st.commit(slip, 0.0, 0.0, 1.0)
     unjumped = float(st.surviving()[:n_old].sum())
     st.compact()
     return dict(ok=True, sigma_max=sigma_max, sigma_min=st.sigma, period=period,
