@@ -15,6 +15,7 @@ import math
 import numpy as np
 from numba import njit
 
+
 @njit(cache=True)
 def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, co, j0, nn, off, m, ylo, h):
     """Fill ``co`` for a step of length ``dt`` from time ``t`` (slip ``X``, stress ``sigma``):

@@ -267,8 +267,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     """The stick-slip limit cycle at drive velocity ``V`` with total global shocks, by the
     cohort method (module docstring), iterated cycle to cycle from ``start`` (a result at
     a nearby V or another ``h``, of this method or :func:`micro.cycle.cycle_fixed_point`).
-    Without one, the transient cycles run at twice ``dt`` and ``h`` first (from the
-    first shock's image), and their fixed point is the start.
+    Without one (or when it has no delta_R marginal: its shocks were not total), the
+    transient cycles run at twice ``dt`` and ``h`` first (from the first shock's image),
+    and their fixed point is the start.
 
     The sequence of cycle extrema converges geometrically; the result is Aitken's
     extrapolation of the last three cycles, stopped when two consecutive extrapolations
@@ -292,7 +293,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         raise ValueError(f"h must be at most kappa * zbar = {model.kappa * model.zbar:g}, got {h!r}")
     if int(max_iter) != max_iter or max_iter < 4:
         raise ValueError(f"max_iter must be an integer >= 4, got {max_iter!r}")
-    if start is None and h <= 0.5 * model.kappa * model.zbar:
+    if (start is None or (start is not _NO_COARSE and start.p is None)) and h <= 0.5 * model.kappa * model.zbar:
         # the transient cycles at twice the steps and cells (an eighth of the cost), to a
         # looser tolerance: the fixed point there is the start (as a coarser h in a sweep)
         coarse = cycle_cohorts(model, V, dt=2.0 * dt, h=2.0 * h, tol=max(4.0 * tol, 1e-4), max_iter=max_iter,
