@@ -172,8 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--method", choices=("auto", "fp", "cycle", "cohort"), default="auto",
                    help="auto: steady rows from the renewal chain, others by Fokker-Planck time-stepping (default); "
                         "fp: time-step every row; cycle: stick-slip rows as the fixed point of the shock-to-shock map "
-                        "(small k0; default eps kappa*zbar/8); cohort: stick-slip rows by the grid-free cohort method "
-                        "(default delta_R cell kappa*zbar/20); both fall back to time-stepping where shocks are not total")
+                        "(small k0; default eps kappa*zbar/8; falls back to time-stepping where shocks are not total); "
+                        "cohort: stick-slip rows by the grid-free cohort method, at any k0 (default delta_R cell "
+                        "kappa*zbar/20; falls back to time-stepping where jumps are not exponential)")
     s.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,V,regime,sigma_max,sigma_min,sigma_mean,...")
 
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "

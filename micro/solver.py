@@ -472,7 +472,9 @@ def stationary(
     delta_R, every crossed mass is an exact integral, and where a shock starts is a
     continuous function of the state, so the cycles converge smoothly and are
     extrapolated (``eps`` is its delta_R cell, default ``kappa * zbar / 20``; time step
-    0.01).  Same fallback and continuation as ``"cycle"``.
+    0.01).  Shocks need not be total; it falls back to time-stepping only where jumps
+    are not exponential or no shock ends a loading phase.  Continuation as with
+    ``"cycle"``.
 
     ``method="auto"`` (the default) asks the renewal chain first
     (:func:`micro.steady_sliding`): where steady sliding is stable its stress is exact
