@@ -124,6 +124,15 @@ def _survivors_cell(q0, q1, m, i4, lam):
 
 
 @njit(cache=True)
+def _cell(Da, Dy, ylo, j, h, index, q):
+    """Cell ``index`` of the pool, at node ``j``: its left edge in delta_R, the threshold at
+    its two ends, where its floor is stored, and its density at its two ends."""
+    y0 = ylo + j * h
+    d0 = Da + Dy * y0
+    return y0, d0, d0 + Dy * h, 4 * index, q[2 * index], q[2 * index + 1]
+
+
+@njit(cache=True)
 def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw):
     """H(dX) = zbar * (jumps per block in the step if the slip is dX) - dX, and dH/d(dX).
     First crossings are integrated exactly over each cell's crossed part; a block that
@@ -140,11 +149,7 @@ def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw):
         D1 = co[c, 3]
         o = off[c]
         for k in range(nn[c]):
-            y0 = ylo + (j0[c] + k) * h
-            d0 = Da + Dy * y0; d1 = d0 + Dy * h
-            i2 = 2 * (o + k)
-            i4 = 4 * (o + k)
-            q0 = q[i2]; q1 = q[i2 + 1]
+            y0, d0, d1, i4, q0, q1 = _cell(Da, Dy, ylo, j0[c] + k, h, o + k, q)
             for p in range(2):
                 lo, hi, ma, mb = _piece(m, i4, p)
                 a, b = _piece_range(d0, d1, ma, mb, lo, hi)
@@ -286,11 +291,7 @@ def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2
         if co[c, 3] * dX <= co[c, 5]:
             continue
         for k in range(nn[c]):
-            y0 = ylo + (j0[c] + k) * h
-            d0 = Da + Dy * y0; d1 = d0 + Dy * h
-            i2 = 2 * (o + k)
-            i4 = 4 * (o + k)
-            q0 = q[i2]; q1 = q[i2 + 1]
+            y0, d0, d1, i4, q0, q1 = _cell(Da, Dy, ylo, j0[c] + k, h, o + k, q)
             crossed = False
             cross_total = 0.0
             for p in range(2):
