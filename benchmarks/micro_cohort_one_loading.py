@@ -16,8 +16,6 @@ from __future__ import annotations
 import math
 import time
 
-import numpy as np
-
 import micro
 from micro import cycle as CY
 from micro.cohort import _one_cycle, _start
@@ -32,12 +30,8 @@ def main() -> None:
     for _ in range(160):
         out = _one_cycle(st, dt)
     print(f"cohorts after 160 cycles: sigma_max {out['sigma_max']:.6f}, period {out['period']:.4f}")
-    c = st.n - 1  # the last shock's newborn cohort
-    o, k = st.off[c], st.nn[c]
-    nodes = st.ylo + (st.j0[c] + np.arange(k + 1)) * h
-    dens = np.concatenate([st.q[2 * o:2 * (o + k):2], [st.q[2 * (o + k) - 1]]])
-    keep = dens > 0.0
-    p = (nodes[keep], dens[keep] / dens[keep].sum())
+    nodes, masses = st.marginal(st.n - 1)  # the last shock's newborn cohort
+    p = (nodes, masses / masses.sum())
     one = _one_cycle(_start(model, V, h, p), dt)
     print(f"cohorts, one loading from the product state: sigma_max {one['sigma_max']:.6f}, "
           f"period {one['period']:.4f}")

@@ -39,7 +39,7 @@ import time
 import numpy as np
 
 from . import _cohort_kernels as CK
-from .cycle import CycleFixedPoint
+from .cycle import CycleFixedPoint, _initial_marginal, _rows
 from .params import KIND_EXPONENTIAL, Model
 
 __all__ = ["cycle_cohorts"]
@@ -110,6 +110,16 @@ class _Cohorts:
         floors[:] = (0.0, 0.0, 1.0, 0.0)  # (ends, no kink)
         self.pool += cells
         self.n += 1
+
+    def marginal(self, c: int) -> tuple[np.ndarray, np.ndarray]:
+        """Cohort ``c``'s delta_R density as masses on its nodes (those with mass), as
+        (nodes, masses): after a total shock, with ``c`` its newborn cohort, the state's
+        marginal."""
+        o, k = self.off[c], self.nn[c]
+        nodes = self.ylo + (self.j0[c] + np.arange(k + 1)) * self.h
+        dens = np.concatenate([self.q[2 * o:2 * (o + k):2], [self.q[2 * (o + k) - 1]]])
+        keep = dens > 0.0
+        return nodes[keep], dens[keep] * self.h
 
     def surviving(self) -> np.ndarray:
         out = np.zeros(self.n)
@@ -182,23 +192,14 @@ def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | 
     """The state after a total shock: Exp(kappa zbar) margins times a delta_R marginal,
     ``p`` (nodes, masses) or every dashpot relaxed to the lag of an Exp margin."""
     st = _Cohorts(model, V, h)
+    j_lo = int(round(st.ylo / h))
     if p is None:
-        lam = st.lam
-        delta = (np.arange(4000) + 0.5) * (lam * 40.0 / 4000)
-        w = np.exp(-delta / lam)
-        y, w = model.k2 / model.kappa * (lam - delta), w / w.sum()
+        dep = _initial_marginal(model, h, j_lo, st.ny)
     else:
-        y, w = p[0], p[1] / p[1].sum()
-    u = (y - st.ylo) / h
-    i = np.floor(u).astype(np.int64)
-    inside = (i >= 0) & (i + 1 < st.ny)
-    if w[~inside].sum() > 1e-12:
-        raise ValueError(f"the starting delta_R marginal lies outside the nodes ({w[~inside].sum():.2g} of its mass)")
-    u, i, w = u[inside], i[inside], w[inside]  # (the nodes' range depends on h: negligible tails may fall off)
-    f = u - i
-    dep = np.zeros(st.ny)
-    np.add.at(dep, i, w * (1.0 - f))
-    np.add.at(dep, i + 1, w * f)
+        # (the nodes' range depends on h: negligible tails may fall off)
+        dep, outside = _rows(p[0], p[1] / p[1].sum(), h, j_lo, st.ny)
+        if outside > 1e-12:
+            raise ValueError(f"the starting delta_R marginal lies outside the nodes ({outside:.2g} of its mass)")
     st.sigma = model.f_th - st.lam + float(dep @ (st.ylo + np.arange(st.ny) * h))
     st.add(dep)
     return st
@@ -364,10 +365,5 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         unjumped=out.get("unjumped", math.nan), converged=converged, message=message,
         wall_time=time.perf_counter() - begin, applicable=applicable, history=values)
     if applicable and len(hist) and st.n == 1:  # (after a total shock the state is its delta_R marginal)
-        c = 0
-        nodes = st.ylo + (st.j0[c] + np.arange(st.nn[c] + 1)) * h
-        o, k = st.off[c], st.nn[c]
-        dens = np.concatenate([st.q[2 * o:2 * (o + k):2], [st.q[2 * (o + k) - 1]]])
-        keep = dens > 0.0
-        res.p = (nodes[keep], dens[keep] * h)
+        res.p = st.marginal(0)
     return res
