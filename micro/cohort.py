@@ -126,9 +126,11 @@ class _Cohorts:
         CK.survivors(self.n, self.j0, self.nn, self.off, self.q, self.m, self.h, self.lam, out)
         return out
 
-    def compact(self) -> None:
-        """Drop the cohorts that have all but crossed, and pack the cells."""
-        keep = np.flatnonzero(self.surviving() > SURVIVOR_FLOOR)
+    def compact(self, surviving: np.ndarray | None = None) -> None:
+        """Drop the cohorts that have all but crossed (``surviving``: their surviving
+        masses, if known), and pack the cells."""
+        surviving = self.surviving() if surviving is None else surviving
+        keep = np.flatnonzero(surviving > SURVIVOR_FLOOR)
         q, m = np.zeros_like(self.q), np.zeros_like(self.m)
         p = 0
         for i, c in enumerate(keep):
@@ -246,8 +248,9 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     except RuntimeError as err:
         return dict(ok=False, message=str(err))
     st.commit(slip, 0.0, 0.0, 1.0)
-    unjumped = float(st.surviving()[:n_old].sum())
-    st.compact()
+    surviving = st.surviving()
+    unjumped = float(surviving[:n_old].sum())
+    st.compact(surviving)
     return dict(ok=True, sigma_max=sigma_max, sigma_min=st.sigma, period=period,
                 sigma_mean=integral / period if period > 0 else sigma_max, unjumped=unjumped,
                 start=sigma_start)
