@@ -412,3 +412,16 @@ def test_docs_example_runs():
         exec(compile(code, "docs/reference/micro_nblock.md", "exec"), namespace)
     assert namespace["cycle"].regime == "stick-slip"
     assert namespace["steady"].sigma_stderr > 0.0
+
+
+def test_stick_slip_extrema_flag_a_transient():
+    # k0 = 0.01, V = 1 (0.125 V^c): from the relaxed start sigma_max falls from 0.989 towards
+    # 0.9622 over some 30 cycles, so with no discarded shock the sequence drifts and says so
+    model = nb.Model(k0=0.01)
+    out = nb.stick_slip_extrema_nblock(model, 1.0, 5000, n_cycles=10, n_discard=0)
+    assert out.status == "transient"
+    assert "raise n_discard" in out.message
+    seq = out.shocks["sigma_before"].to_numpy()
+    assert seq[0] - seq[-1] > 0.01
+    # the standard error is not the naive one of a strongly correlated sequence
+    assert out.sigma_max_stderr > seq.std(ddof=1) / np.sqrt(seq.size)
