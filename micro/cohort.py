@@ -54,6 +54,13 @@ SURVIVOR_FLOOR = 1e-15
 FOLD_TOL = 1e-7
 #: The time step is cut so that a loading phase has at least this many steps.
 STEPS_PER_CYCLE = 50
+#: Anderson's acceleration (close to V^c): the window, and the evaluations without progress
+#: after which it stops.
+ANDERSON_WINDOW = 10
+ANDERSON_STALL = 8
+#: Anderson's map drops the blocks a shock leaves unjumped: it is used only where they are
+#: at most this fraction (the plain cycles that verify its result restore them).
+ANDERSON_UNJUMPED = 1e-3
 #: Most cells the cohorts may hold (about 50 MB).
 MAX_CELLS = 3_000_000
 #: A last step d between cycles leaves at most STILL * d to go when they contract by 0.8 a cycle.
@@ -115,11 +122,16 @@ class _Cohorts:
         """Cohort ``c``'s delta_R density as masses on its nodes (those with mass), as
         (nodes, masses): after a total shock, with ``c`` its newborn cohort, the state's
         marginal."""
+        masses = self.dense(c)
+        keep = masses > 0.0
+        return self.ylo + np.flatnonzero(keep) * self.h, masses[keep]
+
+    def dense(self, c: int) -> np.ndarray:
+        """Cohort ``c``'s delta_R density as masses on all the state's nodes."""
         o, k = self.off[c], self.nn[c]
-        nodes = self.ylo + (self.j0[c] + np.arange(k + 1)) * self.h
-        dens = np.concatenate([self.q[2 * o:2 * (o + k):2], [self.q[2 * (o + k) - 1]]])
-        keep = dens > 0.0
-        return nodes[keep], dens[keep] * self.h
+        out = np.zeros(self.ny)
+        out[self.j0[c]:self.j0[c] + k + 1] = np.concatenate([self.q[2 * o:2 * (o + k):2], [self.q[2 * (o + k) - 1]]])
+        return out * self.h
 
     def surviving(self) -> np.ndarray:
         out = np.zeros(self.n)
@@ -190,12 +202,16 @@ class _Cohorts:
         return hi
 
 
-def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | None) -> _Cohorts:
+def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | None,
+           dep: np.ndarray | None = None) -> _Cohorts:
     """The state after a total shock: Exp(kappa zbar) margins times a delta_R marginal,
-    ``p`` (nodes, masses) or every dashpot relaxed to the lag of an Exp margin."""
+    ``p`` (nodes, masses), or ``dep`` (masses on the state's own nodes), or every dashpot
+    relaxed to the lag of an Exp margin."""
     st = _Cohorts(model, V, h)
     j_lo = int(round(st.ylo / h))
-    if p is None:
+    if dep is not None:
+        dep = dep / dep.sum()
+    elif p is None:
         dep = _initial_marginal(model, h, j_lo, st.ny)
     else:
         # (the nodes' range depends on h: negligible tails may fall off)
@@ -205,6 +221,50 @@ def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | 
     st.sigma = model.f_th - st.lam + float(dep @ (st.ylo + np.arange(st.ny) * h))
     st.add(dep)
     return st
+
+
+def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol: float,
+              max_evals: int) -> tuple[np.ndarray | None, int]:
+    """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
+    total shock (a product state), for the sequences that contract slowly (close to V^c).
+
+    One evaluation is one cycle from a product state; the blocks its shock leaves unjumped
+    (at most ANDERSON_UNJUMPED of the mass) are dropped.  Type-II Anderson
+    mixing with a window of ANDERSON_WINDOW, stopped when a cycle moves less than ``tol``
+    of the mass, or when ANDERSON_STALL evaluations did not improve on the best one.
+    Returns the best marginal (or None if the map does not apply) and the evaluations used.
+    """
+    xs: list[np.ndarray] = []
+    gs: list[np.ndarray] = []
+    x, best, best_f = dep / dep.sum(), None, math.inf
+    since = 0
+    for k in range(1, max_evals + 1):
+        st = _start(model, V, h, None, dep=x)
+        out = _one_cycle(st, dt)
+        if not out["ok"] or out["unjumped"] > ANDERSON_UNJUMPED or out["period"] < 0.8 * STEPS_PER_CYCLE * dt:
+            return best, k
+        g = st.dense(st.n - 1)
+        g /= g.sum()
+        f = float(np.abs(g - x).sum())
+        log.debug("anderson %d: sigma_max %.10f, the cycle moves %.2e of the mass", k, out["sigma_max"], f)
+        if f < best_f:
+            best, best_f, since = g, f, 0
+        else:
+            since += 1
+        if best_f <= tol or since >= ANDERSON_STALL:
+            return best, k
+        xs.append(x)
+        gs.append(g)
+        del xs[:-ANDERSON_WINDOW - 1], gs[:-ANDERSON_WINDOW - 1]
+        if len(xs) < 2:
+            x = g
+            continue
+        F = np.array([b - a for a, b in zip(xs, gs)])
+        dF, dG = np.diff(F, axis=0).T, np.diff(np.array(gs), axis=0).T
+        gamma = np.linalg.lstsq(dF, F[-1], rcond=None)[0]
+        x = np.maximum(g - dG @ gamma, 0.0)
+        x /= x.sum()
+    return best, max_evals
 
 
 def _one_cycle(st: _Cohorts, dt: float) -> dict:
@@ -266,6 +326,38 @@ def _aitken(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return a[-1] + corr, rho
 
 
+def _estimate(a: np.ndarray, extrapolated: np.ndarray, previous: np.ndarray, rho: np.ndarray,
+              tol: float) -> tuple[np.ndarray, list[str], np.ndarray]:
+    """Each quantity's (column of ``a``, one row per cycle) error, how it was estimated
+    and its best value, from the last three cycles, their Aitken extrapolation (and the
+    previous one) and the ratio ``rho`` of their last two differences:
+
+    - ratio in [0, 0.95]: the differences contract steadily, Aitken's extrapolation, with
+      twice its change as the error;
+    - the cycles agree to ``tol / 100``, or alternate (noise, not a drift) by less than
+      ``tol / STILL``: the last cycle, with STILL times the last steps as the error;
+    - otherwise (slow, ratio near 1, or irregular): the last cycle, with the tail of a
+      contraction by the ratio, ``step / (1 - ratio)``.
+
+    Each quantity is judged on its own: one that alternates at round-off must not hide
+    another that still drifts.
+    """
+    steps = np.abs(a[-1] - a[-2])
+    last_two = np.maximum(steps, np.abs(a[-2] - a[-3]))
+    errors, how, best = np.empty(a.shape[1]), [], a[-1].copy()
+    for i in range(a.shape[1]):
+        if 0.0 <= rho[i] <= 0.95:
+            errors[i], best[i] = 2.0 * abs(extrapolated[i] - previous[i]), extrapolated[i]
+            how.append("Aitken")
+        elif steps[i] <= tol / 100.0 or (rho[i] < 0.0 and last_two[i] <= tol / STILL):
+            errors[i] = STILL * last_two[i]
+            how.append("last steps")
+        else:
+            errors[i] = steps[i] / max(1.0 - rho[i], 1e-3)
+            how.append("slow")
+    return errors, how, best
+
+
 def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None = None, tol: float = 1e-5,
                   max_iter: int = 200, start=None) -> CycleFixedPoint:
     """The stick-slip limit cycle at drive velocity ``V`` with total global shocks, by the
@@ -275,13 +367,13 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     transient cycles run at twice ``dt`` and ``h`` first (from the first shock's image),
     and their fixed point is the start.
 
-    The sequence of cycle extrema converges geometrically; the result is Aitken's
-    extrapolation of the last three cycles, stopped when two consecutive extrapolations
-    of sigma_max and sigma_min agree to ``tol / 2`` with a contraction ratio in [0, 0.95]
-    (``error`` is twice that change), or the last cycle when the cycles agree to
-    ``tol / 100`` or alternate by less than ``tol / STILL`` (``error`` is STILL times the
-    last steps); a sequence that contracts slowly (ratio above 0.95) is given the error
-    ``step / (1 - ratio)``.  It is the error of the fixed point at this ``dt`` and
+    The sequence of cycle extrema converges geometrically; each of sigma_max and sigma_min
+    gets its error from the last three cycles (:func:`_estimate`: Aitken's extrapolation
+    where the contraction ratio lies in [0, 0.95], ``step / (1 - ratio)`` where it is
+    slower), and the iteration stops when both are within ``tol``.  Close to V^c, where
+    the ratio nears 1 and the shocks are all but total, the marginal after a shock is
+    accelerated by Anderson's method (:func:`_anderson`) and the result verified by plain
+    cycles again.  ``error`` is the error of the fixed point at this ``dt`` and
     ``h``, not their discretisation error (``h`` defaults to ``kappa zbar / 20``).  ``dt``
     is cut to a fiftieth of the loading phase where that is shorter (close to V^c).
     ``eps`` in the result is ``h``.
@@ -310,7 +402,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     value = np.full(4, math.nan)
     previous = None
     out: dict = {}
-    for it in range(1, int(max_iter) + 1):
+    it = accelerated = 0
+    while it < max_iter:
+        it += 1
         out = _one_cycle(st, dt)
         if not out["ok"]:
             applicable, message = False, out["message"]
@@ -325,9 +419,10 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if not out["period"] > 1e-9:
             applicable, message = False, "a shock started with no loading phase (the state is past its fold)"
             break
-        if out["period"] < STEPS_PER_CYCLE * dt:
+        if out["period"] < 0.8 * STEPS_PER_CYCLE * dt:
             # close to V^c the loading phase is short: resolve it with STEPS_PER_CYCLE
-            # steps, and start the sequence again at the new step
+            # steps, and start the sequence again at the new step (not at every small
+            # change of the period: each cut restarts the sequence)
             dt = out["period"] / STEPS_PER_CYCLE
             hist.clear()
             previous = None
@@ -336,35 +431,35 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f", it, out["sigma_max"], out["sigma_min"])
         if len(hist) >= 3:
             extrapolated, rho = _aitken(np.array(hist))
-            step = max(abs(hist[-1][i] - hist[-2][i]) for i in (0, 1))
-            last_two = max(step, max(abs(hist[-2][i] - hist[-3][i]) for i in (0, 1)))
             if previous is not None:
-                change = float(np.max(np.abs(extrapolated[:2] - previous[:2])))
-                rho_max = float(np.max(rho[:2]))
-                if np.all(rho[:2] >= 0.0) and rho_max <= 0.95:
-                    # the differences contract steadily: Aitken's estimate
-                    error, how, best = 2.0 * change, "Aitken", extrapolated
-                elif step <= tol / 100.0 or (np.any(rho[:2] < 0.0) and last_two <= tol / STILL):
-                    # the cycles agree to round-off, or alternate (noise, not a drift) by
-                    # little: the last steps times the tail of a contraction by 0.8
-                    error, how, best = STILL * max(step, last_two), "last steps", np.array(hist[-1])
-                else:
-                    # slow (ratio near 1) or irregular: the tail of a contraction by rho_max
-                    error, how, best = step / max(1.0 - rho_max, 1e-3), "slow", np.array(hist[-1])
+                errors, how, best = _estimate(np.array(hist), extrapolated, previous, rho, tol)
+                error = float(errors[:2].max())
+                slow = [i for i in (0, 1) if how[i] == "slow" and rho[i] > 0.9]
+                if not accelerated and error > tol and slow and out["unjumped"] <= ANDERSON_UNJUMPED:
+                    # a product state contracting slowly (close to V^c): accelerate it,
+                    # then verify the result by the plain cycles again
+                    accelerated = 1
+                    x, used = _anderson(model, V, h, dt, st.dense(st.n - 1), tol, int(max_iter) - it)
+                    it += used
+                    if x is not None:
+                        st = _start(model, V, h, None, dep=x)
+                        hist.clear()
+                        previous = None
+                        continue
                 if error <= tol:
                     converged, value = True, best
-                    message = (f"limit cycle by cohorts: cycles {it - 2}-{it} (of {it}) give sigma_max and "
-                               f"sigma_min to {error:.1e} ({how})")
+                    message = (f"limit cycle by cohorts: cycles {it - 2}-{it} (of {it}) give sigma_max to "
+                               f"{errors[0]:.1e} ({how[0]}) and sigma_min to {errors[1]:.1e} ({how[1]})")
                     break
             previous = extrapolated
-    else:
+    if not converged and not message:
         message = f"no fixed point to {tol:g} in {max_iter} cycles (error estimate {error:.2g})"
     values = np.array(hist).reshape(-1, 4)
     if not converged and len(values):
         value = values[-1]
     res = CycleFixedPoint(
         model=model, V=V, eps=h, sigma_max=float(value[0]), sigma_min=float(value[1]), period=float(value[2]),
-        sigma_mean=float(value[3]), mass_error=float(st.outside), min_mass=0.0, iterations=len(hist), error=error,
+        sigma_mean=float(value[3]), mass_error=float(st.outside), min_mass=0.0, iterations=it, error=error,
         unjumped=out.get("unjumped", math.nan), converged=converged, message=message,
         wall_time=time.perf_counter() - begin, applicable=applicable, history=values)
     if applicable and len(hist) and st.n == 1:  # (after a total shock the state is its delta_R marginal)
