@@ -7,7 +7,8 @@ state), converged to tol = 1e-6 at (dt, h) = (0.01, kappa zbar / 20), and again 
 law amplitude = A (1 - V/V^c)^nu is fitted over the points closest to V^c, with the
 exponent's standard error from the fit.
 
-Writes benchmarks/results/micro_cohort_amplitude.csv.
+Writes benchmarks/results/micro_cohort_amplitude.csv, a row at a time (rows merge by k0,
+V / V^c, dt and h: ``--k0 0.01`` alone adds its rows).
 
     python benchmarks/micro_cohort_amplitude.py        # about 20 minutes on 1 core
 """
@@ -39,12 +40,31 @@ def fit_law(frac: np.ndarray, amp: np.ndarray) -> tuple[float, float, float]:
     return float(coef[0]), float(np.sqrt(cov[0, 0])), float(np.exp(coef[1]))
 
 
+KEY = ["k0", "V_over_Vc", "dt", "h"]
+
+
+def save(rows: list[dict], out: Path) -> pd.DataFrame:
+    """Merge ``rows`` into the CSV at ``out`` (a row replaces the one with its k0, V / V^c,
+    dt and h), so that an interrupted run keeps its rows and runs at other k0 add theirs."""
+    frame = pd.DataFrame(rows)
+    if out.exists():
+        old = pd.read_csv(out)
+        old = old[~old.set_index(KEY).index.isin(frame.set_index(KEY).index)]
+        frame = pd.concat([old, frame], ignore_index=True)
+    frame = frame.sort_values(["k0", "V_over_Vc", "dt"], ascending=[False, True, False]).reset_index(drop=True)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(out, index=False)
+    return frame
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--k0", default="0.1,0.01")
     ap.add_argument("--fractions", default=",".join(str(f) for f in FRACTIONS))
+    ap.add_argument("--max-iter", type=int, default=400, help="cycles (and accelerated cycles) per point")
     ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_amplitude.csv"))
     args = ap.parse_args()
+    out = Path(args.out)
     rows = []
     for k0 in (float(v) for v in args.k0.split(",")):
         model = micro.Model(k0=k0)
@@ -55,7 +75,7 @@ def main() -> None:
             V = frac * Vc
             for dt, h in ((0.01, lam / 20.0), (0.005, lam / 40.0)):
                 t = time.perf_counter()
-                res = cycle_cohorts(model, V, dt=dt, h=h, tol=1e-6, start=starts.get(h))
+                res = cycle_cohorts(model, V, dt=dt, h=h, tol=1e-6, start=starts.get(h), max_iter=args.max_iter)
                 if res.p is not None:
                     starts[h] = res
                 rows.append(dict(k0=k0, Vc=Vc, V_over_Vc=frac, V=V, dt=dt, h=h, sigma_max=res.sigma_max,
@@ -64,9 +84,7 @@ def main() -> None:
                                  converged=res.converged, applicable=res.applicable,
                                  wall_s=time.perf_counter() - t, message=res.message))
                 print({k: v for k, v in rows[-1].items() if k != "message"}, flush=True)
-    frame = pd.DataFrame(rows)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(args.out, index=False)
+                frame = save(rows, out)
     fine = frame[(frame.dt == 0.005) & frame.converged]
     for k0, grp in fine.groupby("k0", sort=False):
         near = grp[grp.V_over_Vc >= 0.98]

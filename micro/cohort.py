@@ -224,7 +224,7 @@ def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | 
 
 
 def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol: float,
-              max_evals: int) -> tuple[np.ndarray | None, int]:
+              max_evals: int) -> tuple[_Cohorts | None, int]:
     """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
     total shock (a product state), for the sequences that contract slowly (close to V^c).
 
@@ -232,7 +232,9 @@ def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol:
     (at most ANDERSON_UNJUMPED of the mass) are dropped.  Type-II Anderson
     mixing with a window of ANDERSON_WINDOW, stopped when a cycle moves less than ``tol``
     of the mass, or when ANDERSON_STALL evaluations did not improve on the best one.
-    Returns the best marginal (or None if the map does not apply) and the evaluations used.
+    Returns the state after the best evaluation's cycle (its newborn marginal the best
+    image, with the blocks that cycle's shock left: a state of the full dynamics), or None
+    if the map does not apply, and the evaluations used.
     """
     xs: list[np.ndarray] = []
     gs: list[np.ndarray] = []
@@ -248,7 +250,7 @@ def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol:
         f = float(np.abs(g - x).sum())
         log.debug("anderson %d: sigma_max %.10f, the cycle moves %.2e of the mass", k, out["sigma_max"], f)
         if f < best_f:
-            best, best_f, since = g, f, 0
+            best, best_f, since = st, f, 0
         else:
             since += 1
         if best_f <= tol or since >= ANDERSON_STALL:
@@ -402,7 +404,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     value = np.full(4, math.nan)
     previous = None
     out: dict = {}
-    it = accelerated = 0
+    it, accelerated = 0, False
     while it < max_iter:
         it += 1
         out = _one_cycle(st, dt)
@@ -438,11 +440,11 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 if not accelerated and error > tol and slow and out["unjumped"] <= ANDERSON_UNJUMPED:
                     # a product state contracting slowly (close to V^c): accelerate it,
                     # then verify the result by the plain cycles again
-                    accelerated = 1
-                    x, used = _anderson(model, V, h, dt, st.dense(st.n - 1), tol, int(max_iter) - it)
+                    accelerated = True
+                    fast, used = _anderson(model, V, h, dt, st.dense(st.n - 1), tol, int(max_iter) - it)
                     it += used
-                    if x is not None:
-                        st = _start(model, V, h, None, dep=x)
+                    if fast is not None:
+                        st = fast
                         hist.clear()
                         previous = None
                         continue
