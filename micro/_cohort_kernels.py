@@ -347,15 +347,12 @@ def _new_floor(m, i4, d0, d1, q0, q1, crossed, lam):
     if 0.0 < sk < 1.0:
         pts[npt] = sk; npt += 1
     for p in range(2):
+        # where the threshold crosses this piece of the floor (an end of the part above it)
         lo, hi, f0, f1 = _piece(m, i4, p)
-        if hi <= lo:
-            continue
-        gl = (d0 - f0) + ((d1 - f1) - (d0 - f0)) * lo
-        gh = (d0 - f0) + ((d1 - f1) - (d0 - f0)) * hi
-        if (gl > 0.0) != (gh > 0.0) and gl != gh:
-            sc = lo + (hi - lo) * gl / (gl - gh)
-            if lo < sc < hi:
-                pts[npt] = sc; npt += 1
+        a, b = _piece_range(d0, d1, f0, f1, lo, hi)
+        sc = b if a == lo else a
+        if a >= 0.0 and lo < sc < hi:
+            pts[npt] = sc; npt += 1
     pts[npt] = 1.0; npt += 1
     x = np.sort(pts[:npt])
     v = np.empty(npt)

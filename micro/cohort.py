@@ -223,6 +223,13 @@ def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | 
     return st
 
 
+def _step_too_long(period: float, dt: float) -> bool:
+    """Whether a loading phase of ``period`` has too few steps of ``dt``: fewer than 0.8
+    STEPS_PER_CYCLE (not at every small change of the period: each cut of the step
+    restarts the cycle sequence)."""
+    return period < 0.8 * STEPS_PER_CYCLE * dt
+
+
 def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol: float,
               max_evals: int) -> tuple[_Cohorts | None, int]:
     """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
@@ -243,7 +250,7 @@ def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol:
     for k in range(1, max_evals + 1):
         st = _start(model, V, h, None, dep=x)
         out = _one_cycle(st, dt)
-        if not out["ok"] or out["unjumped"] > ANDERSON_UNJUMPED or out["period"] < 0.8 * STEPS_PER_CYCLE * dt:
+        if not out["ok"] or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], dt):
             return best, k
         g = st.dense(st.n - 1)
         g /= g.sum()
@@ -421,10 +428,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if not out["period"] > 1e-9:
             applicable, message = False, "a shock started with no loading phase (the state is past its fold)"
             break
-        if out["period"] < 0.8 * STEPS_PER_CYCLE * dt:
+        if _step_too_long(out["period"], dt):
             # close to V^c the loading phase is short: resolve it with STEPS_PER_CYCLE
-            # steps, and start the sequence again at the new step (not at every small
-            # change of the period: each cut restarts the sequence)
+            # steps, and start the sequence again at the new step
             dt = out["period"] / STEPS_PER_CYCLE
             hist.clear()
             previous = None
