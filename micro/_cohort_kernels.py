@@ -13,11 +13,16 @@ floor and threshold at dX = 0 (cohorts that cannot cross are skipped).
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
+
+#: The cohorts are summed in this many interleaved chunks (the order of the sums does not
+#: depend on the number of threads), in parallel from PARALLEL_COHORTS cohorts on.
+CHUNKS = 8
+PARALLEL_COHORTS = 64
 
 
 @njit(cache=True)
-def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, co, j0, nn, off, m, ylo, h):
+def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, co, j0, nn, off, q, m, ylo, h):
     """Fill ``co`` for a step of length ``dt`` from time ``t`` (slip ``X``, stress ``sigma``):
     a member born with margin delta' crosses once delta' <= D0 + Dy delta_R + D1 dX, dX the
     step's slip (the step's drive, dashpot relaxation and redistribution in it).  Returns
@@ -43,6 +48,8 @@ def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, 
         gap = math.inf
         o = off[c]
         for k in range(nn[c]):
+            if q[2 * (o + k)] == 0.0 and q[2 * (o + k) + 1] == 0.0:
+                continue
             d0 = co[c, 1] + co[c, 2] * (ylo + (j0[c] + k) * h)
             i4 = 4 * (o + k)
             dh = co[c, 2] * h
@@ -55,9 +62,19 @@ def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, 
 
 @njit(cache=True)
 def _i1(A, B, c, e):
-    """int_0^1 (A + B s) exp(-c - e s) ds (a series for small e)."""
-    if abs(e) < 1e-4:
-        return math.exp(-c) * (A * (1 - e / 2 + e * e / 6 - e ** 3 / 24) + B * (0.5 - e / 3 + e * e / 8 - e ** 3 / 30))
+    """int_0^1 (A + B s) exp(-c - e s) ds: by its series for |e| < 0.5 (the closed form
+    loses digits there: (1 - e^-e (1 + e)) / e^2 about 1e-16 / e^2 of them), else in
+    closed form."""
+    if abs(e) < 0.5:
+        # sum_n (-e)^n / n! * (A / (n + 1) + B / (n + 2)); the 19th term is below 1e-21
+        term = 1.0
+        a_sum = 0.0
+        b_sum = 0.0
+        for n in range(19):
+            a_sum += term / (n + 1)
+            b_sum += term / (n + 2)
+            term *= -e / (n + 1)
+        return math.exp(-c) * (A * a_sum + B * b_sum)
     ee = math.exp(-e)
     return math.exp(-c) * (A * (1 - ee) / e + B * (1 - ee * (1 + e)) / (e * e))
 
@@ -133,44 +150,72 @@ def _cell(Da, Dy, ylo, j, h, index, q):
 
 
 @njit(cache=True)
+def _closure_cohort(c, dX, co, j0, nn, off, q, m, ylo, h, lam, gx, gw):
+    """Cohort ``c``'s jumps per block in the step if its slip is ``dX``, and their
+    derivative in dX (:func:`closure`)."""
+    N = 0.0
+    dN = 0.0
+    if co[c, 3] * dX <= co[c, 5]:
+        return N, dN
+    beta = co[c, 0]
+    Da = co[c, 1] + co[c, 3] * dX
+    Dy = co[c, 2]
+    D1 = co[c, 3]
+    o = off[c]
+    for k in range(nn[c]):
+        y0, d0, d1, i4, q0, q1 = _cell(Da, Dy, ylo, j0[c] + k, h, o + k, q)
+        if q0 == 0.0 and q1 == 0.0:
+            continue
+        for p in range(2):
+            lo, hi, ma, mb = _piece(m, i4, p)
+            a, b = _piece_range(d0, d1, ma, mb, lo, hi)
+            if a < 0.0:
+                continue
+            # first crossings, exact
+            cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
+            dcross = _isub(q0, q1, d0, d1, a, b, lam) / lam
+            rej = 0.0
+            L = (b - a)
+            for i in range(gx.size):
+                s = a + L * gx[i]
+                qv = q0 + (q1 - q0) * s
+                mv = ma + (mb - ma) * s
+                Dv = d0 + (d1 - d0) * s
+                em = math.exp(-mv / lam); eD = math.exp(-Dv / lam)
+                rej += gw[i] * qv * ((Dv - mv) * em - lam * (em - eD))
+            rej *= L * beta / lam
+            drej = beta / lam * (cross)
+            N += h * (cross + rej)
+            dN += h * (dcross + drej) * D1
+    return N, dN
+
+
+@njit(cache=True, parallel=True)
 def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw):
     """H(dX) = zbar * (jumps per block in the step if the slip is dX) - dX, and dH/d(dX).
     First crossings are integrated exactly over each cell's crossed part; a block that
     crossed jumps again as a Poisson process of rate 1/lam in its margin's overshoot
-    (exponential jumps), integrated by Gauss-Legendre (nodes ``gx``, weights ``gw``)."""
+    (exponential jumps), integrated by Gauss-Legendre (nodes ``gx``, weights ``gw``).
+    The cohorts are summed in CHUNKS interleaved chunks, in parallel when there are at
+    least PARALLEL_COHORTS of them (the same sums in the same order either way)."""
+    parts = np.zeros((CHUNKS, 2))
+    if n >= PARALLEL_COHORTS:
+        for k in prange(CHUNKS):
+            for c in range(k, n, CHUNKS):
+                Nc, dNc = _closure_cohort(c, dX, co, j0, nn, off, q, m, ylo, h, lam, gx, gw)
+                parts[k, 0] += Nc
+                parts[k, 1] += dNc
+    else:
+        for k in range(CHUNKS):
+            for c in range(k, n, CHUNKS):
+                Nc, dNc = _closure_cohort(c, dX, co, j0, nn, off, q, m, ylo, h, lam, gx, gw)
+                parts[k, 0] += Nc
+                parts[k, 1] += dNc
     N = 0.0
     dN = 0.0
-    for c in range(n):
-        if co[c, 3] * dX <= co[c, 5]:
-            continue
-        beta = co[c, 0]
-        Da = co[c, 1] + co[c, 3] * dX
-        Dy = co[c, 2]
-        D1 = co[c, 3]
-        o = off[c]
-        for k in range(nn[c]):
-            y0, d0, d1, i4, q0, q1 = _cell(Da, Dy, ylo, j0[c] + k, h, o + k, q)
-            for p in range(2):
-                lo, hi, ma, mb = _piece(m, i4, p)
-                a, b = _piece_range(d0, d1, ma, mb, lo, hi)
-                if a < 0.0:
-                    continue
-                # first crossings, exact
-                cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
-                dcross = _isub(q0, q1, d0, d1, a, b, lam) / lam
-                rej = 0.0
-                L = (b - a)
-                for i in range(gx.size):
-                    s = a + L * gx[i]
-                    qv = q0 + (q1 - q0) * s
-                    mv = ma + (mb - ma) * s
-                    Dv = d0 + (d1 - d0) * s
-                    em = math.exp(-mv / lam); eD = math.exp(-Dv / lam)
-                    rej += gw[i] * qv * ((Dv - mv) * em - lam * (em - eD))
-                rej *= L * beta / lam
-                drej = beta / lam * (cross)
-                N += h * (cross + rej)
-                dN += h * (dcross + drej) * D1
+    for k in range(CHUNKS):
+        N += parts[k, 0]
+        dN += parts[k, 1]
     return zbar * N - dX, zbar * dN - 1.0
 
 
@@ -179,7 +224,8 @@ def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw, tol, xmin
     """The smallest root of H (status 0), or status 1 if H has a positive local minimum
     before it: the slip jumps, a fold (the start of a shock).  Newton from 0 with steps
     capped at doubling (from ``xmin``) so that a minimum is not jumped over, then
-    safeguarded Newton in the bracket.  Status 2: no convergence."""
+    safeguarded Newton in the bracket, to ``1e-13 x + tol`` (``tol``: the round-off of H,
+    a sum over every cell, in units of slip).  Status 2: no convergence."""
     x = 0.0
     H, dH = closure(x, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw)
     if H <= 0.0:
@@ -188,6 +234,8 @@ def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw, tol, xmin
         if dH >= 0.0:
             return x, 1
         xn = x - H / dH
+        if xn - x <= 1e-13 * xn + tol:
+            return xn, 0  # (a fold would make the step large, not small)
         cap = 2.0 * x + xmin
         if xn > cap:
             xn = cap
@@ -202,12 +250,16 @@ def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw, tol, xmin
             xt = a - Ha / dHa
             if not (a < xt < b):
                 xt = 0.5 * (a + b)
+            elif xt - a <= 1e-13 * xt + tol:
+                # Newton from the left (H is convex here, so it stays left of the root
+                # and b never moves): converged to round-off
+                return xt, 0
             Ht, dHt = closure(xt, n, co, j0, nn, off, q, m, ylo, h, lam, zbar, gx, gw)
             if Ht > 0.0:
                 a, Ha, dHa = xt, Ht, dHt
             else:
                 b = xt
-            if b - a <= 1e-13 * b or Ht == 0.0:
+            if b - a <= 1e-13 * b + tol or Ht == 0.0:
                 return b, 0
         return b, 0
     return x, 2
@@ -271,65 +323,88 @@ def deposit(dep, mass, ytop, B, W, lam, ylo, h):
 
 
 @njit(cache=True)
+def _commit_cohort(c, dX, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, r2, k2, f_th, gx, gw, dep):
+    """:func:`commit` for cohort ``c``; returns the mass that fell outside the nodes."""
+    bad = 0.0
+    beta = co[c, 0]; E = co[c, 4]
+    Da = co[c, 1] + co[c, 3] * dX
+    Dy = co[c, 2]
+    o = off[c]
+    Jn = J[c] * Edt + (X - X0[c]) * (1.0 - Edt) + phi * dX
+    J[c] = Jn
+    if co[c, 3] * dX <= co[c, 5]:
+        return bad
+    for k in range(nn[c]):
+        y0, d0, d1, i4, q0, q1 = _cell(Da, Dy, ylo, j0[c] + k, h, o + k, q)
+        if q0 == 0.0 and q1 == 0.0:
+            continue
+        crossed = False
+        cross_total = 0.0
+        for p in range(2):
+            lo, hi, ma, mb = _piece(m, i4, p)
+            a, b = _piece_range(d0, d1, ma, mb, lo, hi)
+            if a < 0.0:
+                continue
+            crossed = True
+            cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
+            if cross <= 0.0:
+                continue
+            cross_total += cross
+            # newborns at the Gauss points, scaled to the exact crossed mass
+            L = b - a
+            tot = 0.0
+            for i in range(gx.size):
+                s = a + L * gx[i]
+                qv = q0 + (q1 - q0) * s
+                mv = ma + (mb - ma) * s
+                Dv = d0 + (d1 - d0) * s
+                tot += gw[i] * qv * (math.exp(-mv / lam) - math.exp(-Dv / lam))
+            for i in range(gx.size):
+                s = a + L * gx[i]
+                qv = q0 + (q1 - q0) * s
+                mv = ma + (mb - ma) * s
+                Dv = d0 + (d1 - d0) * s
+                mass = gw[i] * qv * (math.exp(-mv / lam) - math.exp(-Dv / lam))
+                if mass <= 0.0 or tot <= 0.0:
+                    continue
+                mass *= h * cross / tot
+                if mass < 1e-18:
+                    continue
+                yv = y0 + s * h
+                Btil = r2 * (1.0 - E)
+                Atil = yv * E + r2 * (1.0 - E) * (f_th - s0[c] + yv) + k2 * Jn
+                bad += deposit(dep, mass, Atil - Btil * mv, Btil, Dv - mv, lam, ylo, h)
+        if crossed:
+            _new_floor(m, i4, d0, d1, q0, q1, cross_total, lam)
+    return bad
+
+
+@njit(cache=True, parallel=True)
 def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2, kappa, f_th, gx, gw, dep):
     """Apply a step of slip ``dX``: the crossed members' delta_R (a linear function of
     their margin at birth, so an exponential on a segment) is deposited exactly on the
     hat functions of the nodes ``ylo + j h`` (``dep``: the newborn cohort, margins
     Exp(lam) after their re-jumps); a crossed cell gets the new floor, the larger of
     the old floor and the threshold (:func:`_new_floor`).  Returns the mass that fell
-    outside the nodes."""
+    outside the nodes.  Chunks of cohorts as in :func:`closure`, each depositing into
+    its own row."""
     r2 = k2 / kappa
-    ny = dep.size
+    deps = np.zeros((CHUNKS, dep.size))
+    bads = np.zeros(CHUNKS)
+    if n >= PARALLEL_COHORTS:
+        for k in prange(CHUNKS):
+            for c in range(k, n, CHUNKS):
+                bads[k] += _commit_cohort(c, dX, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, r2,
+                                          k2, f_th, gx, gw, deps[k])
+    else:
+        for k in range(CHUNKS):
+            for c in range(k, n, CHUNKS):
+                bads[k] += _commit_cohort(c, dX, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, r2,
+                                          k2, f_th, gx, gw, deps[k])
     bad = 0.0
-    for c in range(n):
-        beta = co[c, 0]; E = co[c, 4]
-        Da = co[c, 1] + co[c, 3] * dX
-        Dy = co[c, 2]
-        o = off[c]
-        Jn = J[c] * Edt + (X - X0[c]) * (1.0 - Edt) + phi * dX
-        J[c] = Jn
-        if co[c, 3] * dX <= co[c, 5]:
-            continue
-        for k in range(nn[c]):
-            y0, d0, d1, i4, q0, q1 = _cell(Da, Dy, ylo, j0[c] + k, h, o + k, q)
-            crossed = False
-            cross_total = 0.0
-            for p in range(2):
-                lo, hi, ma, mb = _piece(m, i4, p)
-                a, b = _piece_range(d0, d1, ma, mb, lo, hi)
-                if a < 0.0:
-                    continue
-                crossed = True
-                cross = _isub(q0, q1, ma, mb, a, b, lam) - _isub(q0, q1, d0, d1, a, b, lam)
-                if cross <= 0.0:
-                    continue
-                cross_total += cross
-                # newborns at the Gauss points, scaled to the exact crossed mass
-                L = b - a
-                tot = 0.0
-                for i in range(gx.size):
-                    s = a + L * gx[i]
-                    qv = q0 + (q1 - q0) * s
-                    mv = ma + (mb - ma) * s
-                    Dv = d0 + (d1 - d0) * s
-                    tot += gw[i] * qv * (math.exp(-mv / lam) - math.exp(-Dv / lam))
-                for i in range(gx.size):
-                    s = a + L * gx[i]
-                    qv = q0 + (q1 - q0) * s
-                    mv = ma + (mb - ma) * s
-                    Dv = d0 + (d1 - d0) * s
-                    mass = gw[i] * qv * (math.exp(-mv / lam) - math.exp(-Dv / lam))
-                    if mass <= 0.0 or tot <= 0.0:
-                        continue
-                    mass *= h * cross / tot
-                    if mass < 1e-18:
-                        continue
-                    yv = y0 + s * h
-                    Btil = r2 * (1.0 - E)
-                    Atil = yv * E + r2 * (1.0 - E) * (f_th - s0[c] + yv) + k2 * Jn
-                    bad += deposit(dep, mass, Atil - Btil * mv, Btil, Dv - mv, lam, ylo, h)
-            if crossed:
-                _new_floor(m, i4, d0, d1, q0, q1, cross_total, lam)
+    for k in range(CHUNKS):
+        bad += bads[k]
+        dep += deps[k]
     return bad
 
 
@@ -402,3 +477,10 @@ def survivors(n, j0, nn, off, q, m, h, lam, out):
             i2 = 2 * (o + k)
             s += _survivors_cell(q[i2], q[i2 + 1], m, 4 * (o + k), lam)
         out[c] = s * h
+
+
+@njit(cache=True)
+def cell_survivors(pool, q, m, h, lam, out):
+    """The mass of every cell of the pool (the first ``pool``) that has not crossed yet."""
+    for i in range(pool):
+        out[i] = _survivors_cell(q[2 * i], q[2 * i + 1], m, 4 * i, lam) * h

@@ -18,17 +18,21 @@ discretised in the margin: a cohort's density is piecewise linear on cells of wi
 crossed mass is an exact integral of an exponential.  A step of length ``dt`` solves the mean-field closure for its
 slip (``dX = zbar x`` the jumps it causes, a crossed block jumping again as a Poisson
 process of its overshoot); the loading phase ends where the closure's smallest root
-jumps (a fold), located by bisecting the step; the shock is the same closure in zero
-time.  Where a near-critical avalanche runs away is then a continuous function of
-the state, so the cycle-to-cycle sequence converges smoothly (geometrically, by about
-0.8 per cycle) and is extrapolated by Aitken's method.
+jumps (a fold), approached on a graded mesh (the creep accelerates like
+(t* - t)^(-1/2) there); the shock is the same closure in zero time.  Where a
+near-critical avalanche runs away is then a continuous function of the state, so the
+cycle-to-cycle sequence converges smoothly (geometrically) and is extrapolated by
+Aitken's method.  ``sigma_max`` is the largest stress of the cycle: the creep before a
+shock can outrun the drive, so the stress peaks before the shock starts
+(``sigma_before``, the paper's sigma_B; 1e-3 lower at k0 = 0.3).
 
 Shocks need not be total: the blocks a shock leaves unjumped stay in their cohorts
 with raised floors (at k0 = 0.1 and 0.3 their cohorts live for many cycles, and the
-cost per cycle grows with them).  Refinement variables: the time step ``dt`` and the cell width
-``h`` (measured orders in benchmarks/micro_cohort_refinement.py).  Needs exponential
-jumps, and a loading phase that ends in a shock within ``20 kappa zbar / (k0 V)``
-(otherwise ``applicable=False``).
+cost per cycle grows with them; cells whose blocks have all but crossed are dropped).
+The kernels sum the cohorts in parallel (numba threads) when there are many.
+Refinement variables: the time step ``dt`` and the cell width ``h`` (measured orders in
+benchmarks/micro_cohort_refinement.py).  Needs exponential jumps, and a loading phase
+that ends in a shock within ``20 kappa zbar / (k0 V)`` (otherwise ``applicable=False``).
 """
 from __future__ import annotations
 
@@ -48,8 +52,8 @@ log = logging.getLogger(__name__)
 
 _GX, _GW = np.polynomial.legendre.leggauss(2)
 _GX, _GW = 0.5 * _GX + 0.5, 0.5 * _GW
-#: Cohorts whose surviving mass is below this are dropped.
-SURVIVOR_FLOOR = 1e-15
+#: Cells whose surviving mass (a fraction of all blocks) is below this are dropped.
+CELL_FLOOR = 1e-13
 #: The start of a shock is located to this fraction of the time step.
 FOLD_TOL = 1e-7
 #: The time step is cut so that a loading phase has at least this many steps.
@@ -87,6 +91,8 @@ class _Cohorts:
         self.t = self.X = self.sigma = 0.0
         self.last = 0.0
         self.outside = 0.0
+        self.dropped = 0.0  # the mass of the cells dropped by compact()
+        self.dt = math.nan  # the time step of the run that left this state
 
     # -------------------------------------------------------------- storage
     def add(self, dep: np.ndarray) -> None:
@@ -95,7 +101,16 @@ class _Cohorts:
         if idx.size == 0:
             return
         a, b = max(idx[0] - 1, 0), min(idx[-1] + 2, self.ny)  # a node of zero density at each end
+        nodes = dep[a:b] / self.h
         cells = b - a - 1
+        floors = np.empty((cells, 4))
+        floors[:] = (0.0, 0.0, 1.0, 0.0)  # (ends, no kink)
+        self._append((self.t, self.X, self.sigma, 0.0), a, np.column_stack([nodes[:-1], nodes[1:]]), floors)
+
+    def _append(self, scalars: tuple[float, float, float, float], j0: int, q: np.ndarray, m: np.ndarray) -> None:
+        """Store a cohort: its (t0, X0, s0, J), first node ``j0``, and per cell the density
+        at both ends ``q`` (cells x 2) and the floor ``m`` (cells x 4)."""
+        cells = q.shape[0]
         if self.n + 1 > self.t0.size or 2 * (self.pool + cells) > self.q.size or 4 * (self.pool + cells) > self.m.size:
             self.compact()
             if self.n + 1 > self.t0.size:
@@ -108,15 +123,43 @@ class _Cohorts:
                 self.q = np.concatenate([self.q, np.zeros(extra)])
                 self.m = np.concatenate([self.m, np.zeros(2 * extra)])
         c, p = self.n, self.pool
-        self.t0[c], self.X0[c], self.s0[c], self.J[c] = self.t, self.X, self.sigma, 0.0
-        self.j0[c], self.nn[c], self.off[c] = a, cells, p
-        nodes = dep[a:b] / self.h
-        self.q[2 * p:2 * (p + cells):2] = nodes[:-1]
-        self.q[2 * p + 1:2 * (p + cells):2] = nodes[1:]
-        floors = self.m[4 * p:4 * (p + cells)].reshape(cells, 4)
-        floors[:] = (0.0, 0.0, 1.0, 0.0)  # (ends, no kink)
+        self.t0[c], self.X0[c], self.s0[c], self.J[c] = scalars
+        self.j0[c], self.nn[c], self.off[c] = j0, cells, p
+        self.q[2 * p:2 * (p + cells)] = q.ravel()
+        self.m[4 * p:4 * (p + cells)] = m.ravel()
         self.pool += cells
         self.n += 1
+
+    def moved(self, V: float, h: float) -> _Cohorts | None:
+        """The same blocks driven at ``V``, on cells of width ``h``: this state's ``h``
+        (a copy) or half of it (every cell split in two; the density and the floors are
+        the same piecewise-linear functions, so nothing is approximated); None for other
+        ``h``.  Cells that fall outside the new nodes count as ``outside``."""
+        split = 2 if math.isclose(self.h, 2.0 * h, rel_tol=1e-12) else 1
+        if split == 1 and not math.isclose(self.h, h, rel_tol=1e-12):
+            return None
+        st = _Cohorts(self.model, V, h)
+        shift = int(round((self.ylo - st.ylo) / h))  # the new index of this state's node 0
+        st.outside = self.outside
+        for c in range(self.n):
+            o, k = self.off[c], self.nn[c]
+            q = self.q[2 * o:2 * (o + k)].reshape(k, 2)
+            m = self.m[4 * o:4 * (o + k)].reshape(k, 4)
+            if split == 2:
+                q, m = _split_cells(q, m)
+            j0 = shift + split * self.j0[c]
+            lo, hi = max(0, -j0), max(min(q.shape[0], st.ny - 1 - j0), 0)
+            if lo > 0 or hi < q.shape[0]:
+                cut = np.ones(q.shape[0], bool)
+                cut[lo:hi] = False
+                lost = np.empty(int(cut.sum()))
+                CK.cell_survivors(lost.size, q[cut].ravel(), m[cut].ravel(), h, self.lam, lost)
+                st.outside += float(lost.sum())
+            if hi > lo:
+                st._append((self.t0[c], self.X0[c], self.s0[c], self.J[c]), j0 + lo, q[lo:hi], m[lo:hi])
+        st.t, st.X, st.sigma, st.last, st.dt = self.t, self.X, self.sigma, self.last, self.dt
+        st.dropped = self.dropped
+        return st
 
     def marginal(self, c: int) -> tuple[np.ndarray, np.ndarray]:
         """Cohort ``c``'s delta_R density as masses on its nodes (those with mass), as
@@ -138,29 +181,41 @@ class _Cohorts:
         CK.survivors(self.n, self.j0, self.nn, self.off, self.q, self.m, self.h, self.lam, out)
         return out
 
-    def compact(self, surviving: np.ndarray | None = None) -> None:
-        """Drop the cohorts that have all but crossed (``surviving``: their surviving
-        masses, if known), and pack the cells."""
-        surviving = self.surviving() if surviving is None else surviving
-        keep = np.flatnonzero(surviving > SURVIVOR_FLOOR)
+    def compact(self) -> None:
+        """Drop the cells whose surviving mass is below CELL_FLOOR (their density set to 0,
+        and the cohort trimmed to the cells that remain: its blocks with margins so far
+        above the threshold that they have all but crossed; their mass is counted in
+        ``dropped``), the cohorts with no cell left, and pack the cells."""
+        cell = np.empty(self.pool)
+        CK.cell_survivors(self.pool, self.q, self.m, self.h, self.lam, cell)
         q, m = np.zeros_like(self.q), np.zeros_like(self.m)
-        p = 0
-        for i, c in enumerate(keep):
+        p = i = 0
+        for c in range(self.n):
             k, o = self.nn[c], self.off[c]
-            q[2 * p:2 * (p + k)] = self.q[2 * o:2 * (o + k)]
-            m[4 * p:4 * (p + k)] = self.m[4 * o:4 * (o + k)]
-            for name in ("t0", "X0", "s0", "J", "j0", "nn"):
+            alive = np.flatnonzero(cell[o:o + k] > CELL_FLOOR)
+            self.dropped += float(cell[o:o + k].sum() - cell[o:o + k][alive].sum())
+            if alive.size == 0:
+                continue
+            a, b = alive[0], alive[-1] + 1
+            k = b - a
+            q[2 * p:2 * (p + k)] = self.q[2 * (o + a):2 * (o + b)]
+            m[4 * p:4 * (p + k)] = self.m[4 * (o + a):4 * (o + b)]
+            dead = np.setdiff1d(np.arange(a, b), alive) - a
+            q[2 * (p + dead)] = 0.0
+            q[2 * (p + dead) + 1] = 0.0
+            for name in ("t0", "X0", "s0", "J"):
                 getattr(self, name)[i] = getattr(self, name)[c]
-            self.off[i] = p
+            self.j0[i], self.nn[i], self.off[i] = self.j0[c] + a, k, p
             p += k
-        self.q, self.m, self.pool, self.n = q, m, p, keep.size
+            i += 1
+        self.q, self.m, self.pool, self.n = q, m, p, i
 
     # -------------------------------------------------------------- dynamics
     def prepare(self, dt: float) -> tuple[float, float]:
         md = self.model
         return CK.coefficients(self.t, dt, self.X, self.sigma, self.V, md.k0, md.k1, md.k2, md.f_th, md.gamma,
                                self.t0, self.X0, self.s0, self.J, self.n, self.co, self.j0, self.nn, self.off,
-                               self.m, self.ylo, self.h)
+                               self.q, self.m, self.ylo, self.h)
 
     def closure(self, dX: float) -> tuple[float, float]:
         return CK.closure(dX, self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
@@ -170,7 +225,7 @@ class _Cohorts:
         """The step's slip (after :meth:`prepare`) and 0, or 1 if the step starts a shock."""
         xmin = max(1e-9 * self.model.zbar, 0.25 * self.last)
         return CK.smallest_root(self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
-                                self.lam, self.model.zbar, _GX, _GW, 1e-16, xmin)
+                                self.lam, self.model.zbar, _GX, _GW, 1e-15 * self.model.zbar, xmin)
 
     def commit(self, dX: float, dt: float, phi: float, Edt: float) -> None:
         md = self.model
@@ -202,6 +257,26 @@ class _Cohorts:
         return hi
 
 
+def _split_cells(q: np.ndarray, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every cell (densities ``q`` at its ends, floor ``m``: ends, kink position, kink
+    value) as its two halves, the same functions."""
+    m0, m1, sk, mk = m.T
+    mid_q = 0.5 * (q[:, 0] + q[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mid_m = np.where(sk >= 0.5, m0 + (mk - m0) * np.where(sk > 0.0, 0.5 / sk, 0.0),
+                         mk + (m1 - mk) * (0.5 - sk) / (1.0 - sk))
+    left_kink = (sk > 0.0) & (sk < 0.5)
+    right_kink = (sk > 0.5) & (sk < 1.0)
+    left = np.column_stack([m0, mid_m, np.where(left_kink, 2.0 * sk, 1.0), np.where(left_kink, mk, mid_m)])
+    right = np.column_stack([mid_m, m1, np.where(right_kink, 2.0 * sk - 1.0, 1.0), np.where(right_kink, mk, m1)])
+    q_out = np.empty((2 * q.shape[0], 2))
+    q_out[0::2] = np.column_stack([q[:, 0], mid_q])
+    q_out[1::2] = np.column_stack([mid_q, q[:, 1]])
+    m_out = np.empty((2 * m.shape[0], 4))
+    m_out[0::2], m_out[1::2] = left, right
+    return q_out, m_out
+
+
 def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | None,
            dep: np.ndarray | None = None) -> _Cohorts:
     """The state after a total shock: Exp(kappa zbar) margins times a delta_R marginal,
@@ -221,6 +296,15 @@ def _start(model: Model, V: float, h: float, p: tuple[np.ndarray, np.ndarray] | 
     st.sigma = model.f_th - st.lam + float(dep @ (st.ylo + np.arange(st.ny) * h))
     st.add(dep)
     return st
+
+
+def _continued(start, model: Model, V: float, h: float) -> _Cohorts | None:
+    """The whole state of a previous result ``start`` (same model) to continue from at
+    ``V`` with cells ``h``, or None if it has none or it cannot be moved there."""
+    state = getattr(start, "state", None)
+    if state is None or start.model != model:
+        return None
+    return state.moved(V, h)
 
 
 def _step_too_long(period: float, dt: float) -> bool:
@@ -277,10 +361,28 @@ def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol:
 
 
 def _one_cycle(st: _Cohorts, dt: float) -> dict:
-    """Load in steps of ``dt`` until a step starts a shock, locate the shock's start by
-    bisecting that step, then apply the shock."""
+    """Load in steps of ``dt`` until a step starts a shock, approach the shock's start
+    within that step on a graded mesh (halve the rest of the step; take the half when
+    it does not start the shock), then apply the shock.
+
+    The creep accelerates like (t* - t)^(-1/2) towards the start of a shock (a fold of
+    the closure), so a step that ends close to it is the least accurate: the graded
+    approach keeps that error from depending on where the start falls in the step.
+    The stress peaks where the creep overtakes the drive, before the shock starts:
+    ``sigma_max`` is that peak (the largest stress of the cycle), ``sigma_before`` the
+    stress when the shock starts, ``sigma_min`` the smallest stress of the loading (it
+    starts at the last shock's ``sigma_after``)."""
     t_start, sigma_start, integral = st.t, st.sigma, 0.0
+    peak = trough = st.sigma
     t_max = 20.0 * st.lam / (st.model.k0 * st.V)
+
+    def advance(x, length, phi, Edt):
+        nonlocal integral, peak, trough
+        s0 = st.sigma
+        st.commit(x, length, phi, Edt)
+        integral += 0.5 * (s0 + st.sigma) * length
+        peak, trough = max(peak, st.sigma), min(trough, st.sigma)
+
     while True:
         if st.t - t_start > t_max:
             return dict(ok=False, message=f"no shock within t = {t_max:.3g} of the last one")
@@ -289,26 +391,18 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
         if status == 2:
             return dict(ok=False, message="the closure of a step did not converge")
         if status == 0:
-            s0 = st.sigma
-            st.commit(x, dt, phi, Edt)
-            integral += 0.5 * (s0 + st.sigma) * dt
+            advance(x, dt, phi, Edt)
             continue
-        lo, hi = 0.0, dt
-        while hi - lo > FOLD_TOL * dt:
-            mid = 0.5 * (lo + hi)
-            st.prepare(mid)
-            if st.root()[1] == 0:
-                lo = mid
-            else:
-                hi = mid
-        if lo > 0.0:
-            phi, Edt = st.prepare(lo)
-            x, _ = st.root()
-            s0 = st.sigma
-            st.commit(x, lo, phi, Edt)
-            integral += 0.5 * (s0 + st.sigma) * lo
+        rest = dt
+        while rest > FOLD_TOL * dt:
+            half = 0.5 * rest
+            phi, Edt = st.prepare(half)
+            x, status = st.root()
+            if status == 0:
+                advance(x, half, phi, Edt)
+            rest = half
         break
-    sigma_max, period = st.sigma, st.t - t_start
+    sigma_before, period = st.sigma, st.t - t_start
     st.prepare(0.0)
     x, _ = st.root()
     n_old = st.n
@@ -317,69 +411,82 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     except RuntimeError as err:
         return dict(ok=False, message=str(err))
     st.commit(slip, 0.0, 0.0, 1.0)
-    surviving = st.surviving()
-    unjumped = float(surviving[:n_old].sum())
-    st.compact(surviving)
-    return dict(ok=True, sigma_max=sigma_max, sigma_min=st.sigma, period=period,
-                sigma_mean=integral / period if period > 0 else sigma_max, unjumped=unjumped,
-                start=sigma_start)
+    unjumped = float(st.surviving()[:n_old].sum())
+    st.compact()
+    return dict(ok=True, sigma_max=peak, sigma_min=trough, period=period,
+                sigma_mean=integral / period if period > 0 else sigma_before, sigma_before=sigma_before,
+                sigma_after=st.sigma, unjumped=unjumped, start=sigma_start)
 
 
-def _aitken(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Aitken's extrapolation of the last three rows of ``a`` (one column per quantity),
-    and the ratio of the last two differences."""
-    d1, d2 = a[-2] - a[-3], a[-1] - a[-2]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rho = np.where(d1 != 0.0, d2 / d1, 0.0)
-        corr = np.where((rho >= 0.0) & (rho < 1.0), d2 * rho / (1.0 - rho), 0.0)
-    return a[-1] + corr, rho
+#: The columns of a cycle's row in the history, and those whose error decides convergence.
+COLUMNS = ("sigma_max", "sigma_min", "period", "sigma_mean", "sigma_before", "sigma_after")
+JUDGED = (0, 1, 4, 5)
+#: Cycles an estimate needs: three Aitken extrapolations, from three pairs of differences.
+WINDOW = 5
 
 
-def _estimate(a: np.ndarray, extrapolated: np.ndarray, previous: np.ndarray, rho: np.ndarray,
-              tol: float) -> tuple[np.ndarray, list[str], np.ndarray]:
-    """Each quantity's (column of ``a``, one row per cycle) error, how it was estimated
-    and its best value, from the last three cycles, their Aitken extrapolation (and the
-    previous one) and the ratio ``rho`` of their last two differences:
+def _estimate(a: np.ndarray, tol: float) -> tuple[np.ndarray, list[str], np.ndarray, np.ndarray]:
+    """Each quantity's (column of ``a``, one row per cycle, at least WINDOW rows) error,
+    how it was estimated, its best value and its contraction ratio (the smallest of the
+    three), from the last WINDOW
+    cycles: four differences, three ratios ``r`` of successive differences, and the
+    three Aitken extrapolations ``a_k + d_k r_k / (1 - r_k)`` they give.
 
-    - ratio in [0, 0.95]: the differences contract steadily, Aitken's extrapolation, with
-      twice its change as the error;
-    - the cycles agree to ``tol / 100``, or alternate (noise, not a drift) by less than
-      ``tol / STILL``: the last cycle, with STILL times the last steps as the error;
-    - otherwise (slow, ratio near 1, or irregular): the last cycle, with the tail of a
-      contraction by the ratio, ``step / (1 - ratio)``.
+    - the last two steps are below ``tol / 100``: converged (to the map's noise), the
+      last cycle, with STILL times those steps as the error;
+    - a ratio is negative (the cycles alternate) and the last three steps are below
+      ``tol / STILL``: noise, not a drift; the last cycle, STILL times the steps;
+    - all three ratios in [0, 1): a geometric tail; the last extrapolation, with twice
+      the spread of the three, plus the tail that the ratio's last rise, repeated once,
+      would add, as the error (a slow mode taking over from a faster one raises the
+      ratio; one that has not shown itself in the window is not seen);
+    - otherwise (irregular, or not contracting): the last cycle, with the tail of the
+      largest ratio, ``steps / (1 - r)`` (a thousand steps if r >= 1).
 
     Each quantity is judged on its own: one that alternates at round-off must not hide
     another that still drifts.
     """
-    steps = np.abs(a[-1] - a[-2])
-    last_two = np.maximum(steps, np.abs(a[-2] - a[-3]))
-    errors, how, best = np.empty(a.shape[1]), [], a[-1].copy()
+    w = a[-WINDOW:]
+    d = np.diff(w, axis=0)
+    errors, how, best, rho = np.empty(a.shape[1]), [], w[-1].copy(), np.zeros(a.shape[1])
     for i in range(a.shape[1]):
-        if 0.0 <= rho[i] <= 0.95:
-            errors[i], best[i] = 2.0 * abs(extrapolated[i] - previous[i]), extrapolated[i]
-            how.append("Aitken")
-        elif steps[i] <= tol / 100.0 or (rho[i] < 0.0 and last_two[i] <= tol / STILL):
-            errors[i] = STILL * last_two[i]
+        di = d[:, i]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.where(di[:-1] != 0.0, di[1:] / di[:-1], 0.0)
+        steps = np.abs(di)
+        rho[i] = float(r.min())
+        if steps[-2:].max() <= tol / 100.0:
+            errors[i] = STILL * steps[-2:].max()
             how.append("last steps")
+        elif (r < 0.0).any() and steps[-3:].max() <= tol / STILL:
+            errors[i] = STILL * steps[-3:].max()
+            how.append("noise")
+        elif ((r >= 0.0) & (r < 1.0)).all():
+            E = w[-3:, i] + di[-3:] * r / (1.0 - r)
+            # a rising ratio (a slower mode taking over) goes on rising: its next step
+            r_hi = min(r[-1] + max(r[-1] - r[0], 0.0), 0.999)
+            tail = steps[-1] * (r_hi / (1.0 - r_hi) - r[-1] / (1.0 - r[-1]))
+            errors[i], best[i] = tail + 2.0 * float(np.abs(E - E[-1]).max()), E[-1]
+            how.append("Aitken")
         else:
-            errors[i] = steps[i] / max(1.0 - rho[i], 1e-3)
+            errors[i] = steps[-3:].max() / max(1.0 - r.max(), 1e-3)
             how.append("slow")
-    return errors, how, best
+    return errors, how, best, rho
 
 
 def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None = None, tol: float = 1e-5,
                   max_iter: int = 200, start=None) -> CycleFixedPoint:
-    """The stick-slip limit cycle at drive velocity ``V`` with total global shocks, by the
-    cohort method (module docstring), iterated cycle to cycle from ``start`` (a result at
-    a nearby V or another ``h``, of this method or :func:`micro.cycle.cycle_fixed_point`).
-    Without one (or when it has no delta_R marginal: its shocks were not total), the
-    transient cycles run at twice ``dt`` and ``h`` first (from the first shock's image),
-    and their fixed point is the start.
-
-    The sequence of cycle extrema converges geometrically; each of sigma_max and sigma_min
-    gets its error from the last three cycles (:func:`_estimate`: Aitken's extrapolation
-    where the contraction ratio lies in [0, 0.95], ``step / (1 - ratio)`` where it is
-    slower), and the iteration stops when both are within ``tol``.  Close to V^c, where
+    """The stick-slip limit cycle at drive velocity ``V``, by the cohort method (module
+    docstring), iterated cycle to cycle from ``start``: a result at a nearby V (same
+    model) or at twice ``h`` of this method, whose whole state it continues, or a result
+    with a delta_R marginal (total shocks; also :func:`micro.cycle.cycle_fixed_point`'s).
+    Without one, the transient cycles run at twice ``dt`` and ``h`` first (from the first
+    shock's image), and their whole state, each cell split in two, is the start.  The
+    sequence of cycle
+    extrema converges geometrically; each of sigma_max, sigma_min, sigma_before and
+    sigma_after gets its error from the last WINDOW cycles (:func:`_estimate`: Aitken's
+    extrapolation where the contraction ratios are steady), and the iteration stops when
+    all are within ``tol`` in two cycles in a row.  Close to V^c, where
     the ratio nears 1 and the shocks are all but total, the marginal after a shock is
     accelerated by Anderson's method (:func:`_anderson`) and the result verified by plain
     cycles again.  ``error`` is the error of the fixed point at this ``dt`` and
@@ -398,20 +505,28 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         raise ValueError(f"h must be at most kappa * zbar = {model.kappa * model.zbar:g}, got {h!r}")
     if int(max_iter) != max_iter or max_iter < 4:
         raise ValueError(f"max_iter must be an integer >= 4, got {max_iter!r}")
-    if (start is None or (start is not _NO_COARSE and start.p is None)) and h <= 0.5 * model.kappa * model.zbar:
+    given = start if start is not None and start is not _NO_COARSE else None
+    st = _continued(given, model, V, h)
+    if st is None and start is not _NO_COARSE and (given is None or given.p is None) \
+            and h <= 0.5 * model.kappa * model.zbar:
         # the transient cycles at twice the steps and cells (an eighth of the cost), to a
-        # looser tolerance: the fixed point there is the start (as a coarser h in a sweep)
-        coarse = cycle_cohorts(model, V, dt=2.0 * dt, h=2.0 * h, tol=max(4.0 * tol, 1e-4), max_iter=max_iter,
+        # looser tolerance: the fixed point there is the start (its whole state, with the
+        # blocks its shocks left, each cell split in two)
+        coarse = cycle_cohorts(model, V, dt=2.0 * dt, h=2.0 * h, tol=max(4.0 * tol, 3e-4), max_iter=max_iter,
                                start=_NO_COARSE)
-        if coarse.applicable and coarse.p is not None:
-            start = coarse
-    st = _start(model, V, h, start.p if start is not None and start is not _NO_COARSE else None)
-    hist: list[tuple[float, float, float, float]] = []
+        if coarse.applicable:
+            st = _continued(coarse, model, V, h)
+            if st is not None:
+                dt = min(dt, st.dt)  # (a step cut to the loading phase stays cut)
+            elif coarse.p is not None:
+                given = coarse
+    if st is None:
+        st = _start(model, V, h, given.p if given is not None else None)
+    hist: list[tuple[float, ...]] = []
     error, converged, applicable, message = math.nan, False, True, ""
-    value = np.full(4, math.nan)
-    previous = None
+    value = np.full(len(COLUMNS), math.nan)
     out: dict = {}
-    it, accelerated = 0, False
+    it, accelerated, passed = 0, False, 0
     while it < max_iter:
         it += 1
         out = _one_cycle(st, dt)
@@ -433,43 +548,49 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             # steps, and start the sequence again at the new step
             dt = out["period"] / STEPS_PER_CYCLE
             hist.clear()
-            previous = None
+            passed = 0
             continue
-        hist.append((out["sigma_max"], out["sigma_min"], out["period"], out["sigma_mean"]))
-        log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f", it, out["sigma_max"], out["sigma_min"])
-        if len(hist) >= 3:
-            extrapolated, rho = _aitken(np.array(hist))
-            if previous is not None:
-                errors, how, best = _estimate(np.array(hist), extrapolated, previous, rho, tol)
-                error = float(errors[:2].max())
-                slow = [i for i in (0, 1) if how[i] == "slow" and rho[i] > 0.9]
-                if not accelerated and error > tol and slow and out["unjumped"] <= ANDERSON_UNJUMPED:
-                    # a product state contracting slowly (close to V^c): accelerate it,
-                    # then verify the result by the plain cycles again
-                    accelerated = True
-                    fast, used = _anderson(model, V, h, dt, st.dense(st.n - 1), tol, int(max_iter) - it)
-                    it += used
-                    if fast is not None:
-                        st = fast
-                        hist.clear()
-                        previous = None
-                        continue
-                if error <= tol:
-                    converged, value = True, best
-                    message = (f"limit cycle by cohorts: cycles {it - 2}-{it} (of {it}) give sigma_max to "
-                               f"{errors[0]:.1e} ({how[0]}) and sigma_min to {errors[1]:.1e} ({how[1]})")
-                    break
-            previous = extrapolated
+        hist.append(tuple(out[name] for name in COLUMNS))
+        log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f", it, out["sigma_max"],
+                  out["sigma_min"], out["sigma_before"])
+        if len(hist) < WINDOW:
+            continue
+        errors, how, best, rho = _estimate(np.array(hist), tol)
+        error = float(errors[list(JUDGED)].max())
+        slow = any(errors[i] > tol and how[i] in ("Aitken", "slow") and rho[i] > 0.9 for i in JUDGED)
+        if not accelerated and error > tol and slow and out["unjumped"] <= ANDERSON_UNJUMPED:
+            # a product state contracting slowly (close to V^c): accelerate it,
+            # then verify the result by the plain cycles again
+            accelerated = True
+            fast, used = _anderson(model, V, h, dt, st.dense(st.n - 1), tol, int(max_iter) - it)
+            it += used
+            if fast is not None:
+                st = fast
+                hist.clear()
+                passed = 0
+                continue
+        passed = passed + 1 if error <= tol else 0
+        if passed >= 2:  # (two cycles in a row: one estimate may pass by chance)
+            converged, value = True, best
+            worst = max(JUDGED, key=lambda i: errors[i])
+            message = (f"limit cycle by cohorts: cycles {it - WINDOW + 1}-{it} (of {it}) give sigma_max to "
+                       f"{errors[0]:.1e} ({how[0]}), sigma_min to {errors[1]:.1e} ({how[1]}); the least certain, "
+                       f"{COLUMNS[worst]}, to {errors[worst]:.1e}")
+            break
     if not converged and not message:
         message = f"no fixed point to {tol:g} in {max_iter} cycles (error estimate {error:.2g})"
-    values = np.array(hist).reshape(-1, 4)
+    values = np.array(hist).reshape(-1, len(COLUMNS))
     if not converged and len(values):
         value = values[-1]
     res = CycleFixedPoint(
         model=model, V=V, eps=h, sigma_max=float(value[0]), sigma_min=float(value[1]), period=float(value[2]),
-        sigma_mean=float(value[3]), mass_error=float(st.outside), min_mass=0.0, iterations=it, error=error,
+        sigma_mean=float(value[3]), mass_error=float(st.outside + st.dropped), min_mass=0.0, iterations=it, error=error,
         unjumped=out.get("unjumped", math.nan), converged=converged, message=message,
-        wall_time=time.perf_counter() - begin, applicable=applicable, history=values)
-    if applicable and len(hist) and st.n == 1:  # (after a total shock the state is its delta_R marginal)
-        res.p = st.marginal(0)
+        wall_time=time.perf_counter() - begin, applicable=applicable, history=values,
+        sigma_before=float(value[4]), sigma_after=float(value[5]))
+    if applicable and len(hist):
+        st.dt = dt
+        res.state = st
+        if st.n == 1:  # (after a total shock the state is its delta_R marginal)
+            res.p = st.marginal(0)
     return res

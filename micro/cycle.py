@@ -45,7 +45,7 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import field, dataclass
 
 import numpy as np
 
@@ -84,7 +84,12 @@ class CycleFixedPoint:
     it below ``UNJUMPED_TOL``); ``applicable`` is False when a loading phase ended
     without a global shock or a shock was not total (the map does not describe such
     cycles); ``history`` holds the rows (sigma_max, sigma_min, period, sigma_mean) of
-    every cycle, ``p`` the delta_R marginal (nodes, masses).
+    every cycle (the cohort method adds sigma_before and sigma_after), ``p`` the delta_R
+    marginal (nodes, masses).  The cohort method only: ``state``, the whole state after
+    the last shock, from which a run at a nearby V or at half the cell continues;
+    ``sigma_before`` and ``sigma_after``, the stress when the shock starts and right
+    after it (the paper's sigma_B and sigma_A: ``sigma_max`` is the largest stress of
+    the cycle, which the creep before a shock can put above ``sigma_before``).
     """
 
     model: Model
@@ -105,6 +110,9 @@ class CycleFixedPoint:
     applicable: bool = True
     history: np.ndarray | None = None
     p: tuple[np.ndarray, np.ndarray] | None = None
+    state: object | None = field(default=None, repr=False)
+    sigma_before: float = math.nan
+    sigma_after: float = math.nan
 
 
 # ------------------------------------------------------------------------------ the product state

@@ -145,7 +145,11 @@ class Stationary:
     ``converged`` says whether the stopping test was met; ``message`` says why the run
     ended.  ``mass_error`` (``abs(total probability - 1)``) and ``min_mass`` (the most negative
     cell mass ever seen, 0 if none) are the solver's own checks of the density.
-    ``records`` holds the stress time series when asked for.
+    ``records`` holds the stress time series when asked for.  ``sigma_before`` and
+    ``sigma_after`` (``method="cohort"`` only, NaN otherwise) are the stress when a global
+    shock starts and right after it (the paper's sigma_B and sigma_A): ``sigma_max`` is
+    the largest stress of the cycle, above ``sigma_before`` where the creep that precedes
+    a shock outruns the drive (by up to 1e-3 at k0 = 0.3).
     """
 
     model: Model
@@ -165,6 +169,8 @@ class Stationary:
     shocks_per_cycle: float = math.nan
     mass_error: float = math.nan
     min_mass: float = math.nan
+    sigma_before: float = math.nan
+    sigma_after: float = math.nan
     records: pd.DataFrame | None = field(default=None, repr=False)
     shocks: pd.DataFrame | None = field(default=None, repr=False)
     grid: Grid | None = field(default=None, repr=False)
@@ -175,7 +181,8 @@ class Stationary:
         return {
             "k0": m.k0, "k1": m.k1, "k2": m.k2, "zbar": m.zbar, "V": self.V, "regime": self.regime,
             "sigma_max": self.sigma_max, "sigma_min": self.sigma_min, "sigma_mean": self.sigma_mean,
-            "period": self.period, "sigma_stderr": self.sigma_stderr, "shocks_per_cycle": self.shocks_per_cycle,
+            "sigma_before": self.sigma_before, "sigma_after": self.sigma_after, "period": self.period,
+            "sigma_stderr": self.sigma_stderr, "shocks_per_cycle": self.shocks_per_cycle,
             "converged": self.converged,
             "message": self.message,
             "eps": self.eps, "t_end": self.t_end, "n_cycles": self.n_cycles, "wall_time": self.wall_time,
@@ -416,7 +423,8 @@ def _cycle(model: Model, V: float, numerics: Numerics, convergence: Convergence,
                 sigma_mean=res.sigma_mean, period=res.period, converged=res.converged, message=res.message,
                 t_end=float(np.nansum(res.history[:, 2])) if res.history is not None else math.nan,
                 n_cycles=res.iterations, wall_time=res.wall_time, sigma_stderr=res.error, shocks_per_cycle=1.0,
-                mass_error=res.mass_error, min_mass=res.min_mass, cycle=res)
+                mass_error=res.mass_error, min_mass=res.min_mass, cycle=res, sigma_before=res.sigma_before,
+                sigma_after=res.sigma_after)
         fallback = res.message
     out = stationary(model, V, numerics=replace(numerics, eps=eps), convergence=convergence, warn=warn, method="fp")
     out.message = f"{method} method not applicable ({fallback}): Fokker-Planck time-stepping; {out.message}"

@@ -122,21 +122,25 @@ def test_cli_sweep_method_cohort(tmp_path):
 
 
 def test_each_quantity_is_judged_on_its_own():
-    # sigma_min alternates at round-off while sigma_max still drifts with ratio 0.97: the
-    # error is sigma_max's tail step / (1 - ratio), not the alternation's few steps
-    from micro.cohort import _aitken, _estimate
-    n = np.arange(6)
-    a = np.zeros((6, 4))
-    a[:, 0] = 0.9 - 1e-4 * 0.97 ** n
-    a[:, 1] = 0.899 + 1e-9 * (-1.0) ** n
-    a[:, 2], a[:, 3] = 1.0, 0.9
-    previous, _ = _aitken(a[:-1])
-    extrapolated, rho = _aitken(a)
-    errors, how, best = _estimate(a, extrapolated, previous, rho, 1e-5)
-    assert how[0] == "slow" and how[1] == "last steps"
-    step = 1e-4 * 0.97 ** 4 * 0.03
-    assert errors[0] == pytest.approx(step / 0.03, rel=1e-6)
-    assert errors[1] < 1e-8
+    # column 0: two modes (ratios 0.97 and 0.6): the ratio still rises, and the error
+    # bounds the true distance to the limit once the slow mode shows; column 1 alternates
+    # below tol / STILL: noise, not a drift; column 2: one mode, extrapolated exactly; column 3
+    # jumps (a change of the step count): not contracting, a large error
+    from micro.cohort import _estimate
+    n = np.arange(13)
+    a = np.zeros((13, 4))
+    a[:, 0] = 0.9 - 1e-4 * 0.97 ** n - 3e-4 * 0.6 ** n
+    a[:, 1] = 0.899 + 1e-7 * (-1.0) ** n
+    a[:, 2] = 0.95 + 2e-4 * 0.8 ** n
+    a[:, 3] = 0.93 + 1e-5 * n
+    a[10:, 3] += 4e-5
+    errors, how, best, rho = _estimate(a, 1e-5)
+    assert how == ["Aitken", "noise", "Aitken", "slow"]
+    assert abs(best[0] - 0.9) <= errors[0] < 1e-3
+    assert errors[1] <= 1e-6 + 1e-15 and best[1] == a[-1, 1]
+    assert best[2] == pytest.approx(0.95, abs=1e-13) and errors[2] < 1e-12
+    assert errors[3] > 1e-3
+    assert rho[2] == pytest.approx(0.8, rel=1e-9)
 
 
 def test_anderson_beats_the_plain_cycles_close_to_vc():
