@@ -18,8 +18,8 @@ discretised in the margin: a cohort's density is piecewise linear on cells of wi
 crossed mass is an exact integral of an exponential.  A step of length ``dt`` solves the mean-field closure for its
 slip (``dX = zbar x`` the jumps it causes, a crossed block jumping again as a Poisson
 process of its overshoot); the loading phase ends where the closure's smallest root
-jumps (a fold), approached on a graded mesh (the creep accelerates like
-(t* - t)^(-1/2) there); the shock is the same closure in zero time.  Where a
+jumps (a fold), located by bisecting the step; the shock is the same closure in zero
+time.  Where a
 near-critical avalanche runs away is then a continuous function of the state, so the
 cycle-to-cycle sequence converges smoothly (geometrically) and is extrapolated by
 Aitken's method.  ``sigma_max`` is the largest stress of the cycle: the creep before a
@@ -361,17 +361,18 @@ def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol:
 
 
 def _one_cycle(st: _Cohorts, dt: float) -> dict:
-    """Load in steps of ``dt`` until a step starts a shock, approach the shock's start
-    within that step on a graded mesh (halve the rest of the step; take the half when
-    it does not start the shock), then apply the shock.
+    """Load in steps of ``dt`` until a step starts a shock, locate the shock's start by
+    bisecting that step (one partial step up to it: the cycle map stays continuous in
+    where the start falls), then apply the shock.
 
-    The creep accelerates like (t* - t)^(-1/2) towards the start of a shock (a fold of
-    the closure), so a step that ends close to it is the least accurate: the graded
-    approach keeps that error from depending on where the start falls in the step.
-    The stress peaks where the creep overtakes the drive, before the shock starts:
+    The stress peaks where the creep overtakes the drive, which can be before the shock
+    starts (the creep accelerates like (t* - t)^(-1/2) towards the fold):
     ``sigma_max`` is that peak (the largest stress of the cycle), ``sigma_before`` the
     stress when the shock starts, ``sigma_min`` the smallest stress of the loading (it
-    starts at the last shock's ``sigma_after``)."""
+    starts at the last shock's ``sigma_after``).  (Approaching the start on a graded
+    mesh instead, halving the rest of the step, makes the map discontinuous in where the
+    start falls, and at k0 = 0.3, 0.2 V^c its cycles alternate by 5.6e-5 in
+    sigma_before.)"""
     t_start, sigma_start, integral = st.t, st.sigma, 0.0
     peak = trough = st.sigma
     t_max = 20.0 * st.lam / (st.model.k0 * st.V)
@@ -393,14 +394,18 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
         if status == 0:
             advance(x, dt, phi, Edt)
             continue
-        rest = dt
-        while rest > FOLD_TOL * dt:
-            half = 0.5 * rest
-            phi, Edt = st.prepare(half)
-            x, status = st.root()
-            if status == 0:
-                advance(x, half, phi, Edt)
-            rest = half
+        lo, hi = 0.0, dt
+        while hi - lo > FOLD_TOL * dt:
+            mid = 0.5 * (lo + hi)
+            st.prepare(mid)
+            if st.root()[1] == 0:
+                lo = mid
+            else:
+                hi = mid
+        if lo > 0.0:
+            phi, Edt = st.prepare(lo)
+            x, _ = st.root()
+            advance(x, lo, phi, Edt)
         break
     sigma_before, period = st.sigma, st.t - t_start
     st.prepare(0.0)
