@@ -52,11 +52,17 @@ def _converged(frame: pd.DataFrame) -> np.ndarray:
 
 
 def bifurcation(t: dict[str, pd.DataFrame], Dc: float, fp_k0, path: Path) -> Path:
-    """Figs. 4 and 8: micro (left: exact steady branch, FP stick-slip points) and RS with
-    the fitted law and D_c (right), shared axes."""
+    """Figs. 4 and 8: micro (left: exact steady branch, stick-slip points: those the D_c
+    fit matches and those only shown) and RS with the fitted law and D_c (right), shared
+    axes."""
     branch = t["micro_branch"]
     branch = branch[branch.role == "branch"]
-    pts = t.get("micro_points", pd.DataFrame(columns=["k0", "V", "regime", "sigma_max", "sigma_min", "method"]))
+    cols = ["k0", "V", "regime", "sigma_max", "sigma_min", "method"]
+    frames = [t[name][[c for c in cols + ["converged"] if c in t[name]]]
+              for name in ("micro_points", "micro_shown_points") if name in t and len(t[name])]
+    pts = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=cols)
+    computed = set(fp_k0) | set(pts.k0[pts.regime == "stick-slip"]) if len(pts) else set(fp_k0)
+    method = ", ".join(sorted(set(pts.method.astype(str)))) if len(pts) else "none"
     rs = t["rs_bifurcation"]
     band = t.get("rs_unstable_band")
     fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharex=True, sharey=True)
@@ -71,7 +77,7 @@ def bifurcation(t: dict[str, pd.DataFrame], Dc: float, fp_k0, path: Path) -> Pat
         if vc > 0:
             y = float(np.interp(math.log(vc), np.log(grp.V), grp.sigma))
             ax.plot([vc], [y], "|", color=c, ms=14, mew=2)
-            if not any(math.isclose(k0, k, rel_tol=1e-9) for k in fp_k0):
+            if not any(math.isclose(k0, k, rel_tol=1e-9) for k in computed):
                 ax.annotate("stick-slip not computed", (vc, y), xytext=(0, 12), textcoords="offset points",
                             ha="center", va="bottom", rotation=90, fontsize=6, color=c)
         p = pts[np.isclose(pts.k0, k0) & (pts.regime == "stick-slip")] if len(pts) else pts
@@ -81,7 +87,7 @@ def bifurcation(t: dict[str, pd.DataFrame], Dc: float, fp_k0, path: Path) -> Pat
                 ax.semilogx(p.V[sel], p.sigma_max[sel], "o", color=c, mfc=fill, ms=5)
                 ax.semilogx(p.V[sel], p.sigma_min[sel], "s", color=c, mfc=fill, ms=5)
     ax.set_title("micro (Fig. 4): exact steady branch (dotted: unstable), | = V^c;\n"
-                 "FP stick-slip sigma_max (o), sigma_min (s); open: not converged", fontsize=9)
+                 f"stick-slip sigma_max (o), sigma_min (s) by {method}; open: not converged", fontsize=9)
     ax = axes[1]
     for i, (k0, grp) in enumerate(rs.groupby("k0", sort=False)):
         c = _color(k0, i)

@@ -17,7 +17,7 @@ import numpy as np
 import micro
 import rsf
 
-from ._validation import choices, in_range, positive, positive_array, positive_int
+from ._validation import choice, choices, in_range, positive, positive_array, positive_int
 
 __all__ = ["Settings", "SCENARIOS", "PAPER_K0", "PAPER_SETS"]
 
@@ -35,6 +35,17 @@ def _velocity_ratios(name: str, values) -> tuple[float, ...]:
     return tuple(sorted(positive_array(name, values, low=0.0, high=1e6)))
 
 
+def _stick_slip_points(name: str, pairs) -> tuple[tuple[float, float], ...]:
+    """(k0, V / V^c) pairs, each checked, without duplicates, largest k0 first."""
+    points = []
+    for i, pair in enumerate(pairs):
+        if len(tuple(pair)) != 2:
+            raise ValueError(f"{name}[{i}] must be a (k0, V / V^c) pair, got {pair!r}")
+        points.append((in_range(f"{name}[{i}].k0", pair[0], 0.0, 10.0, low_open=True),
+                       in_range(f"{name}[{i}].ratio", pair[1], 0.0, 1.0, low_open=True, high_open=True)))
+    return tuple(sorted(set(points), key=lambda p: (-p[0], p[1])))
+
+
 def _geom(lo: float, hi: float, n: int) -> tuple[float, ...]:
     return tuple(float(f"{v:.6g}") for v in np.geomspace(lo, hi, n))
 
@@ -47,10 +58,15 @@ class Settings:
     mean ``zbar`` and cutoff ``cutoff``), ``eta_u = f_th = 1``.
 
     Micro's steady branch and V^c are exact (the direct method, ``micro.steady_sliding``
-    and ``micro.critical_velocity``, to 1e-11); only its stick-slip cycles are
-    time-stepped, by the Fokker-Planck equation at the bin ``eps`` (and ``eps_coarse`` for
-    the error bars of the transition) with the stopping rule ``rtol``, ``atol``, ``t_max``
-    (None: micro's default), and by the N-block simulation.
+    and ``micro.critical_velocity``, to 1e-11).  Its stick-slip points on the bifurcation
+    diagram are limit cycles solved by ``cycle_method``: ``"cohort"`` (the default,
+    :mod:`micro.cohort`: no grid in the margin, the cycle-to-cycle sequence extrapolated
+    to its fixed point within ``cycle_rtol`` times the velocity weakening ``f_th -
+    sigma_fast_limit``, about 1e-4 in stress) or ``"fp"`` (the Fokker-Planck equation at
+    the bin ``eps``, whose cycles are off by about 1e-3 at eps = 0.016).  The transition
+    study time-steps the Fokker-Planck equation at ``eps`` and ``eps_coarse`` with the
+    stopping rule ``rtol``, ``atol``, ``t_max`` (None: micro's default), and runs the
+    N-block simulation.
 
     Parameters
     ----------
@@ -62,10 +78,15 @@ class Settings:
         from unstable_from V^c to 0.995 V^c.
     reference_k0, reference_V : a stiffness k0 >= k2, at which micro slides steadily at
         every V; its branch on ``reference_V`` reaches V ~ B and pins the shape of Eq. (10).
-    fp_points : (k0, V / V^c) of the Fokker-Planck stick-slip points that the D_c fit
-        matches (with exact steady points at ``steady_ratios`` V^c at the same k0); ``fp_k0``
-        is the set of their k0.  Near V^c the FP cost grows (a cycle a few bins high settles
-        slowly), at k0 = 0.3 faster than at 0.1: the default keeps k0 = 0.3 below 0.45 V^c.
+    fp_points : (k0, V / V^c) of the stick-slip points that the D_c fit matches (with
+        exact steady points at ``steady_ratios`` V^c at the same k0); ``fp_k0`` is the set
+        of their k0 (the names are older than the cohort method: the points are solved by
+        ``cycle_method``).  With ``cycle_method="fp"``, the FP's cost grows near V^c (a
+        cycle a few bins high settles slowly), at k0 = 0.3 faster than at 0.1.
+    shown_points : (k0, V / V^c) of stick-slip points drawn on the diagram (by
+        ``cycle_method``) but not matched by the fit: micro's side of the diagram at the
+        small k0, where the fitted D_c is a prediction.
+    cycle_method, cycle_rtol : how the stick-slip points are solved (above).
     dc_bounds, dc_grid, bootstrap : D_c search range, scan resolution, bootstrap samples.
     hopf_k0 : k0 of the transition study; ``hopf_distances``: d = (V^c - V)/V^c of its FP
         points (at ``eps`` and ``eps_coarse``); ``nblock_N``, ``nblock_distances``: the
@@ -102,6 +123,10 @@ class Settings:
     reference_V: tuple[float, ...] = _geom(1e-3, 1e3, 25)
     fp_points: tuple[tuple[float, float], ...] = ((0.3, 0.15), (0.3, 0.4), (0.1, 0.15), (0.1, 0.4), (0.1, 0.55),
                                                   (0.1, 0.7))
+    shown_points: tuple[tuple[float, float], ...] = ((0.01, 0.4), (0.01, 0.7), (0.001, 0.4), (0.001, 0.7),
+                                                     (0.0001, 0.4), (0.0001, 0.7))
+    cycle_method: str = "cohort"
+    cycle_rtol: float = 1e-3
     steady_ratios: tuple[float, ...] = (1.5, 3.0)
     dc_bounds: tuple[float, float] = (0.005, 0.5)
     dc_grid: int = 41
@@ -152,13 +177,10 @@ class Settings:
         if self.reference_k0 < self.k2:
             raise ValueError(f"reference_k0 must be >= k2 = {self.k2!r} (steady at every V), got {self.reference_k0!r}")
         set_("reference_V", _velocity_ratios("reference_V", self.reference_V))
-        points = []
-        for i, pair in enumerate(self.fp_points):
-            if len(tuple(pair)) != 2:
-                raise ValueError(f"fp_points[{i}] must be a (k0, V / V^c) pair, got {pair!r}")
-            points.append((in_range(f"fp_points[{i}].k0", pair[0], 0.0, 10.0, low_open=True),
-                           in_range(f"fp_points[{i}].ratio", pair[1], 0.0, 1.0, low_open=True, high_open=True)))
-        set_("fp_points", tuple(sorted(set(points), key=lambda p: (-p[0], p[1]))))
+        set_("fp_points", _stick_slip_points("fp_points", self.fp_points))
+        set_("shown_points", _stick_slip_points("shown_points", self.shown_points))
+        set_("cycle_method", choice("cycle_method", self.cycle_method, ("cohort", "fp")))
+        set_("cycle_rtol", in_range("cycle_rtol", self.cycle_rtol, 1e-6, 0.1))
         set_("steady_ratios", tuple(sorted(positive_array("steady_ratios", self.steady_ratios, low=1.0, high=1e4,
                                                           min_size=0))))
         lo, hi = (positive(f"dc_bounds[{i}]", v) for i, v in enumerate(self.dc_bounds))
@@ -217,7 +239,8 @@ class Settings:
         """A smoke run (seconds once compiled): few points, a coarse bin.  Its numbers only
         show that the pipeline works."""
         base = cls(eps=0.02, eps_coarse=0.025, branch_points=12, unstable_points=6, reference_V=_geom(1e-3, 1e3, 13),
-                   fp_points=((0.1, 0.2), (0.1, 0.4), (0.1, 0.6)), steady_ratios=(1.5,), dc_grid=13, bootstrap=50,
+                   fp_points=((0.1, 0.2), (0.1, 0.4), (0.1, 0.6)), shown_points=((0.001, 0.5),), cycle_rtol=1e-2,
+                   steady_ratios=(1.5,), dc_grid=13, bootstrap=50,
                    rs_points=12, hopf_k0=0.1, hopf_distances=(0.4, 0.6, 0.8), nblock_N=(3000, 10000),
                    nblock_distances=(0.1, 0.2, 0.4), rs_hopf_distances=(0.01, 0.1, 0.3, 0.6),
                    phase_sets=((0.5, 0.5),), phase_points=8, phase_reference_V=_geom(1e-3, 1e3, 13),
@@ -230,6 +253,7 @@ class Settings:
         base = cls(branch_points=80, unstable_points=32, reference_V=_geom(1e-3, 1e3, 49),
                    fp_points=tuple([(0.3, r) for r in (0.05, 0.15, 0.3, 0.4, 0.55)] +
                                    [(0.1, r) for r in (0.05, 0.15, 0.3, 0.4, 0.55, 0.7, 0.85)]),
+                   shown_points=tuple((k0, r) for k0 in (0.01, 0.001, 0.0001) for r in (0.15, 0.4, 0.55, 0.7, 0.85)),
                    steady_ratios=(1.2, 1.5, 2.0, 3.0, 5.0),
                    hopf_distances=(0.15, 0.3, 0.45, 0.6), nblock_N=(100000, 300000),
                    nblock_distances=(0.01, 0.02, 0.03, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5),

@@ -5,17 +5,18 @@ r"""The whole comparison: micro and RS side by side, as tables, figures and ``su
 DataFrames; with ``out`` it also writes them as CSV, the figures as PNG and a summary.
 
 Micro's stationary questions are answered directly (:func:`micro.critical_velocity` and
-:func:`micro.steady_sliding`: the renewal chain of one block, milliseconds per V); only
-the stick-slip cycles are time-stepped (the Fokker-Planck equation at two bins, the
-N-block simulation at two sizes).  Stages are computed when a scenario needs them and
-shared between scenarios:
+:func:`micro.steady_sliding`: the renewal chain of one block, milliseconds per V); the
+stick-slip points of the diagram are limit cycles solved as fixed points of the cycle map
+(:mod:`micro.cohort`, seconds per point at every k0); the transition study time-steps
+(the Fokker-Planck equation at two bins, the N-block simulation at two sizes).  Stages
+are computed when a scenario needs them and shared between scenarios:
 
 * micro's exact V^c at every k0 (and at dozens of k0 per (k1, k2) set for the phase
   diagram), then its exact steady branch on both sides of V^c (the growth rate of the
   unstable mode below it);
 * the Eq. (10) fit to that branch (shared A, B, one offset per k0) with its residual
   against the exact tail and offset;
-* the stick-slip points (FP, N-block), every one in one batch on the runner;
+* the stick-slip points (cohort or FP, N-block), every one in one batch on the runner;
 * D_c two ways: from the stick-slip extrema (:func:`~compare.fits.fit_dc`) and from V^c
   matching (:func:`~compare.fits.fit_dc_critical`).
 
@@ -133,8 +134,8 @@ class _Study:
         if "phase" in scenarios:
             tasks += [VcTask(s.model(k0, k1, k2)) for k1, k2 in s.phase_sets for k0 in self._phase_k0(k2)]
         tasks += self._branch_tasks()
-        if "bifurcation" in scenarios and self.Dc_given is None:
-            tasks += self._diagram_tasks()
+        if "bifurcation" in scenarios:
+            tasks += self._diagram_tasks(fitted=self.Dc_given is None)
         if "bifurcation" in scenarios:
             tasks += self._paper_tasks()
         if "hopf" in scenarios:
@@ -155,7 +156,7 @@ class _Study:
         if "shs" in scenarios:
             k0.append(s.shs_k0)
         if "bifurcation" in scenarios:
-            k0 += list(s.fp_k0)
+            k0 += list(s.fp_k0) + [k for k, _ in s.shown_points]
         return sorted(set(k0), reverse=True)
 
     # -- micro, direct: V^c and the steady branch ------------------------------------------------
@@ -261,16 +262,45 @@ class _Study:
         s = self.s
         return StationaryTask(s.model(k0), _sig(V), s.numerics(eps), s.convergence(), method)
 
-    def _diagram_tasks(self) -> list[StationaryTask]:
+    def _cycle_task(self, k0: float, ratio: float) -> StationaryTask:
+        """Micro's stick-slip cycle at ``ratio`` V^c by ``cycle_method``: the cohort method
+        at its default cell (kappa zbar / 20) to ``cycle_rtol`` of the velocity weakening,
+        or the FP at ``eps``."""
         s = self.s
-        return [self._stationary_task(k0, r * self.Vc(k0), s.eps) for k0, r in s.fp_points if self.Vc(k0) > 0]
+        V = _sig(ratio * self.Vc(k0))
+        if s.cycle_method == "fp":
+            return self._stationary_task(k0, V, s.eps, "fp")
+        model = s.model(k0)
+        return StationaryTask(model, V, micro.Numerics(eps=model.kappa * model.zbar / 20.0),
+                              micro.Convergence(rtol=s.cycle_rtol, atol=0.0), "cohort")
+
+    def _diagram_tasks(self, fitted: bool = True) -> list[StationaryTask]:
+        """The stick-slip points: those the D_c fit matches (with ``fitted``), and those
+        only shown."""
+        s = self.s
+        return self._cycle_tasks((list(s.fp_points) if fitted else []) + list(s.shown_points))
+
+    def _cycle_tasks(self, pairs) -> list[StationaryTask]:
+        return [self._cycle_task(k0, r) for k0, r in pairs if self.Vc(k0) > 0]
+
+    def _points(self, pairs, role: str) -> pd.DataFrame:
+        return micro_frame(self._run(self._cycle_tasks(pairs), "micro stick-slip"), role=role,
+                           method=self.s.cycle_method)
+
+    @cached_property
+    def shown_points(self) -> pd.DataFrame:
+        """Micro's stick-slip points that the diagram shows but the D_c fit does not match."""
+        frame = self._points(self.s.shown_points, "shown")
+        frame["Vc"] = [self.Vc(k) for k in frame.k0]
+        self.tables["micro_shown_points"] = frame
+        return frame
 
     @cached_property
     def micro_points(self) -> pd.DataFrame:
-        """Micro's stick-slip points (FP at ``eps``) and exact steady points of the diagram."""
+        """Micro's stick-slip points (by ``cycle_method``) and exact steady points that the
+        D_c fit matches."""
         s = self.s
-        tasks = self._diagram_tasks()
-        frame = micro_frame(self._run(tasks, "micro stick-slip"), role="diagram", method="fp")
+        frame = self._points(s.fp_points, "diagram")
         frame["Vc"] = [self.Vc(k) for k in frame.k0]
         rows = []
         for k0 in s.fp_k0:
@@ -371,6 +401,8 @@ class _Study:
         self.steady_fit
         if self.Dc_given is None:
             self.dc_fit
+        if s.shown_points:
+            self.shown_points
         crit = self.critical_table()
         Dc = self.Dc
 

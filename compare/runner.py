@@ -64,8 +64,9 @@ class RunStats:
         del self.slowest[5:]
 
 
-#: Environment variables that set the thread count of the BLAS libraries numpy may use.
-_BLAS_THREADS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+#: Environment variables that set the thread count of the BLAS libraries numpy may use, and
+#: of numba's parallel kernels (micro.cohort's).
+_THREADS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
 
 
 def _worker_init(parent_pid: int) -> None:
@@ -255,11 +256,11 @@ class Runner:
             self._pool = ProcessPoolExecutor(max_workers=self.workers,
                                              mp_context=multiprocessing.get_context("spawn"),
                                              initializer=_worker_init, initargs=(os.getpid(),))
-        # one BLAS thread per worker: the workers already fill the cores, and OpenBLAS threads
-        # competing with another worker's made micro's direct solver 4-8x slower (measured);
-        # the spawned workers read these when they import numpy
-        saved = {var: os.environ.get(var) for var in _BLAS_THREADS}
-        os.environ.update({var: "1" for var in _BLAS_THREADS})
+        # one BLAS (and numba) thread per worker: the workers already fill the cores, and
+        # OpenBLAS threads competing with another worker's made micro's direct solver 4-8x
+        # slower (measured); the spawned workers read these when they import numpy and numba
+        saved = {var: os.environ.get(var) for var in _THREADS}
+        os.environ.update({var: "1" for var in _THREADS})
         try:
             # submit() spawns the workers: a Ctrl-C or SIGTERM in the middle of writing a new
             # worker's start-up data to its pipe left that worker to die printing a traceback

@@ -141,14 +141,19 @@ def _bifurcation(study, t, v) -> list[str]:
     if "rs_bifurcation" not in t:
         return []
     s = study.s
+    how = ("limit cycles by the cohort method (fixed points of the cycle map, to "
+           f"{s.cycle_rtol:g} of the velocity weakening)" if s.cycle_method == "cohort"
+           else f"the Fokker-Planck equation (eps = {s.eps:g})")
+    shown = sorted({k for k, _ in s.shown_points}, reverse=True)
     lines = ["## Bifurcation diagrams (Figs. 4/8)", "",
              f"`bifurcation.png`: micro's exact steady branch (line; dotted where unstable) at every k0, its "
-             f"stick-slip extrema from the Fokker-Planck equation (eps = {s.eps:g}) at k0 = "
-             f"{', '.join(f'{k:g}' for k in s.fp_k0) or 'none'} (points); "]
-    missing = [k for k in sorted(set(PAPER_K0) | set(s.k0), reverse=True) if k not in s.fp_k0]
+             f"stick-slip extrema (sigma_max the largest stress of the cycle) from {how} at k0 = "
+             f"{', '.join(f'{k:g}' for k in s.fp_k0) or 'none'} (points the D_c fit matches)"
+             + (f" and {', '.join(f'{k:g}' for k in shown)} (shown, not fitted: there the fitted D_c is a "
+                "prediction)" if shown else "") + "; "]
+    missing = [k for k in sorted(set(PAPER_K0) | set(s.k0), reverse=True) if k not in s.fp_k0 and k not in shown]
     if missing:
-        lines[-1] += (f"micro's stick-slip below V^c at k0 = {', '.join(f'{k:g}' for k in missing)} is not computed "
-                      f"(shaded; the Fokker-Planck cost grows like V and 1/eps at small k0), ")
+        lines[-1] += (f"micro's stick-slip below V^c at k0 = {', '.join(f'{k:g}' for k in missing)} is not computed, ")
     lines[-1] += "RS with the fitted law and D_c on the right; V^c of each model marked."
     band = t.get("rs_unstable_band")
     if band is not None:

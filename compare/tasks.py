@@ -48,6 +48,8 @@ log = logging.getLogger(__name__)
 
 #: Bump when the meaning or layout of a task's record changes.
 TASK_FORMAT = 2
+#: The methods of micro.stationary a StationaryTask may ask for.
+STATIONARY_METHODS = ("auto", "fp", "cohort")
 
 
 @lru_cache(maxsize=1)
@@ -126,7 +128,9 @@ class _TaskBase:
 @dataclass(frozen=True)
 class StationaryTask(_TaskBase):
     """``micro.stationary(model, V, numerics=..., convergence=..., method=...)`` (``method="fp"``
-    time-steps the Fokker-Planck equation even where the direct steady state exists)."""
+    time-steps the Fokker-Planck equation even where the direct steady state exists;
+    ``method="cohort"`` solves a stick-slip cycle by the cohort method, with ``numerics.eps``
+    its delta_R cell)."""
 
     model: micro.Model
     V: float
@@ -137,8 +141,8 @@ class StationaryTask(_TaskBase):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "V", positive("V", self.V))
-        if self.method not in ("auto", "fp"):
-            raise ValueError(f"method must be 'auto' or 'fp', got {self.method!r}")
+        if self.method not in STATIONARY_METHODS:
+            raise ValueError(f"method must be one of {', '.join(map(repr, STATIONARY_METHODS))}, got {self.method!r}")
         _check_common(self.model, self.numerics, self.convergence)
 
     def describe(self) -> dict[str, Any]:
