@@ -59,6 +59,9 @@ FOLD_TOL = 1e-7
 #: A step whose creep exceeds this fraction of the drive keeps a snapshot of the state
 #: before it, from which the end of the loading phase is replayed finely for the peak.
 PEAK_CREEP = 0.2
+#: Where the replay found the peak less than this above the stress at the shock's start
+#: (total shocks, small k0: 1e-12 and less), the next cycles of the run skip it.
+PEAK_FLOOR = 1e-10
 #: The time step is cut so that a loading phase has at least this many steps.
 STEPS_PER_CYCLE = 50
 #: Anderson's acceleration (close to V^c): the window, and the evaluations without progress
@@ -96,6 +99,7 @@ class _Cohorts:
         self.outside = 0.0
         self.dropped = 0.0  # the mass of the cells dropped by compact()
         self.dt = math.nan  # the time step of the run that left this state
+        self.peak_excess = math.inf  # how far the stress peaked above its value at the last shock's start
 
     # -------------------------------------------------------------- storage
     def add(self, dep: np.ndarray) -> None:
@@ -411,6 +415,7 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     t_start, sigma_start, integral = st.t, st.sigma, 0.0
     peak = trough = st.sigma
     snapshot = None
+    replay = st.peak_excess > PEAK_FLOOR
     t_max = 20.0 * st.lam / (st.model.k0 * st.V)
 
     def advance(x, length, phi, Edt):
@@ -430,10 +435,10 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
         if status == 0:
             # keep the state before a step in which the creep approaches the drive: the
             # stress may peak in it, or in the next one, close to the shock's start
-            snapshot = st.copy() if x > PEAK_CREEP * st.V * dt else None
+            snapshot = st.copy() if replay and x > PEAK_CREEP * st.V * dt else None
             advance(x, dt, phi, Edt)
             continue
-        here = st.copy() if snapshot is None else None
+        here = st.copy() if replay and snapshot is None else None
         lo, hi = 0.0, dt
         while hi - lo > FOLD_TOL * dt:
             mid = 0.5 * (lo + hi)
@@ -446,7 +451,10 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
             phi, Edt = st.prepare(lo)
             x, _ = st.root()
             advance(x, lo, phi, Edt)
-        peak = max(peak, _peak_before(snapshot if snapshot is not None else here, st.t, dt))
+        if replay:
+            fine = _peak_before(snapshot if snapshot is not None else here, st.t, dt)
+            st.peak_excess = fine - st.sigma  # (if negligible, the next cycles skip the replay)
+            peak = max(peak, fine)
         break
     sigma_before, period = st.sigma, st.t - t_start
     st.prepare(0.0)
