@@ -6,7 +6,9 @@ variables, the time step dt and the delta_R cell h, are halved together from
 (0.02, 0.01) to (0.005, 0.0025); each level starts from the previous level's fixed point
 and is converged to tol = 1e-6 (``--tol``; Aitken's extrapolation of the cycles).  The order p
 and the limit come from the three levels (sigma(l) = sigma_0 + C 2^(-p l)); sigma_min
-has an exact limit, f_th - kappa zbar: the check of the procedure.  Each row's
+has an exact limit, f_th - kappa zbar, where shocks are total (k0 <= 0.01): the check of
+the procedure.  sigma_max is the largest stress of the cycle, sigma_before and
+sigma_after the stress when the shock starts and right after it.  Each row's
 "distance" is its distance from the extrapolated limit: the error that its run time
 bought.
 
@@ -59,20 +61,22 @@ def main() -> None:
             res = cycle_cohorts(model, V, dt=dt, h=h, tol=args.tol, start=start)
             wall = time.perf_counter() - t
             start = res
-            rows.append(dict(k0=k0, V_over_Vc=args.fraction, V=V, dt=dt, h=h, sigma_max=res.sigma_max, sigma_min=res.sigma_min,
+            rows.append(dict(k0=k0, V_over_Vc=args.fraction, V=V, dt=dt, h=h, sigma_max=res.sigma_max,
+                             sigma_min=res.sigma_min, sigma_before=res.sigma_before, sigma_after=res.sigma_after,
                              exact_sigma_min=micro.sigma_fast_limit(model), period=res.period, error=res.error,
                              cycles=res.iterations, converged=res.converged, wall_s=wall))
             print(rows[-1], flush=True)
     frame = pd.DataFrame(rows)
-    if Path(args.out).exists():
-        old = pd.read_csv(args.out)[list(frame.columns)]
+    old = pd.read_csv(args.out) if Path(args.out).exists() else None
+    if old is not None and set(frame.columns) <= set(old.columns):  # (rows of an older layout are dropped)
+        old = old[list(frame.columns)]
         key = ["k0", "V_over_Vc", "dt", "h"]
         old = old[~old.set_index(key).index.isin(frame.set_index(key).index)]
         frame = pd.concat([old, frame], ignore_index=True).sort_values(["k0", "V_over_Vc", "dt"],
                                                                       ascending=[False, True, False])
         frame = frame.reset_index(drop=True)
     for _, grp in frame.groupby(["k0", "V_over_Vc"], sort=False):
-        for col in ("sigma_max", "sigma_min"):
+        for col in ("sigma_max", "sigma_min", "sigma_before", "sigma_after"):
             p, lim = order_and_limit(grp[col].to_numpy())
             frame.loc[grp.index, f"{col}_order"] = p
             frame.loc[grp.index, f"{col}_limit"] = lim
