@@ -62,7 +62,8 @@ def bifurcation(t: dict[str, pd.DataFrame], Dc: float, fp_k0, path: Path) -> Pat
               for name in ("micro_points", "micro_shown_points") if name in t and len(t[name])]
     pts = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=cols)
     computed = set(fp_k0) | set(pts.k0[pts.regime == "stick-slip"]) if len(pts) else set(fp_k0)
-    method = ", ".join(sorted(set(pts.method.astype(str)))) if len(pts) else "none"
+    cycles = pts[pts.regime == "stick-slip"] if len(pts) else pts
+    method = ", ".join(sorted(set(cycles.method.astype(str)))) if len(cycles) else "none"
     rs = t["rs_bifurcation"]
     band = t.get("rs_unstable_band")
     fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharex=True, sharey=True)
