@@ -468,18 +468,6 @@ def _new_floor(m, i4, d0, d1, q0, q1, crossed, lam):
 
 
 @njit(cache=True)
-def survivors(n, j0, nn, off, q, m, h, lam, out):
-    """The mass of every cohort that has not crossed yet."""
-    for c in range(n):
-        o = off[c]
-        s = 0.0
-        for k in range(nn[c]):
-            i2 = 2 * (o + k)
-            s += _survivors_cell(q[i2], q[i2 + 1], m, 4 * (o + k), lam)
-        out[c] = s * h
-
-
-@njit(cache=True)
 def cell_survivors(pool, q, m, h, lam, out):
     """The mass of every cell of the pool (the first ``pool``) that has not crossed yet."""
     for i in range(pool):

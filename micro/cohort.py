@@ -19,10 +19,9 @@ crossed mass is an exact integral of an exponential.  A step of length ``dt`` so
 slip (``dX = zbar x`` the jumps it causes, a crossed block jumping again as a Poisson
 process of its overshoot); the loading phase ends where the closure's smallest root
 jumps (a fold), located by bisecting the step; the shock is the same closure in zero
-time.  Where a
-near-critical avalanche runs away is then a continuous function of the state, so the
-cycle-to-cycle sequence converges smoothly (geometrically) and is extrapolated by
-Aitken's method.  ``sigma_max`` is the largest stress of the cycle: the creep before a
+time.  Where a near-critical avalanche runs away is then a continuous function of the
+state, so the cycle-to-cycle sequence converges smoothly (geometrically) and is
+extrapolated by Aitken's method.  ``sigma_max`` is the largest stress of the cycle: the creep before a
 shock can outrun the drive, so the stress peaks before the shock starts
 (``sigma_before``, the paper's sigma_B; 1e-3 lower at k0 = 0.3).
 
@@ -193,18 +192,25 @@ class _Cohorts:
         out[self.j0[c]:self.j0[c] + k + 1] = np.concatenate([self.q[2 * o:2 * (o + k):2], [self.q[2 * (o + k) - 1]]])
         return out * self.h
 
-    def surviving(self) -> np.ndarray:
-        out = np.zeros(self.n)
-        CK.survivors(self.n, self.j0, self.nn, self.off, self.q, self.m, self.h, self.lam, out)
+    def cell_masses(self) -> np.ndarray:
+        """The mass of every cell that has not crossed yet."""
+        out = np.empty(self.pool)
+        CK.cell_survivors(self.pool, self.q, self.m, self.h, self.lam, out)
         return out
 
-    def compact(self) -> None:
+    def surviving(self, cell: np.ndarray | None = None) -> np.ndarray:
+        """The mass of every cohort that has not crossed yet (from ``cell``, the cells'
+        masses, if known)."""
+        cell = self.cell_masses() if cell is None else cell
+        return np.add.reduceat(cell, self.off[:self.n]) if self.n else np.zeros(0)
+
+    def compact(self, cell: np.ndarray | None = None) -> None:
         """Drop the cells whose surviving mass is below CELL_FLOOR (their density set to 0,
         and the cohort trimmed to the cells that remain: its blocks with margins so far
         above the threshold that they have all but crossed; their mass is counted in
-        ``dropped``), the cohorts with no cell left, and pack the cells."""
-        cell = np.empty(self.pool)
-        CK.cell_survivors(self.pool, self.q, self.m, self.h, self.lam, cell)
+        ``dropped``), the cohorts with no cell left, and pack the cells.  ``cell``: the
+        cells' masses, if known."""
+        cell = self.cell_masses() if cell is None else cell
         q, m = np.zeros_like(self.q), np.zeros_like(self.m)
         p = i = 0
         for c in range(self.n):
@@ -465,8 +471,9 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     except RuntimeError as err:
         return dict(ok=False, message=str(err))
     st.commit(slip, 0.0, 0.0, 1.0)
-    unjumped = float(st.surviving()[:n_old].sum())
-    st.compact()
+    cell = st.cell_masses()
+    unjumped = float(st.surviving(cell)[:n_old].sum())
+    st.compact(cell)
     return dict(ok=True, sigma_max=peak, sigma_min=trough, period=period,
                 sigma_mean=integral / period if period > 0 else sigma_before, sigma_before=sigma_before,
                 sigma_after=st.sigma, unjumped=unjumped, start=sigma_start)
