@@ -472,3 +472,50 @@ def cell_survivors(pool, q, m, h, lam, out):
     """The mass of every cell of the pool (the first ``pool``) that has not crossed yet."""
     for i in range(pool):
         out[i] = _survivors_cell(q[2 * i], q[2 * i + 1], m, 4 * i, lam) * h
+
+
+@njit(cache=True)
+def compact(n, j0, nn, off, q, m, cell, floor, keep, q_out, m_out):
+    """Pack the cells whose mass ``cell`` exceeds ``floor``, in place of the layout
+    (``j0``, ``nn``, ``off``): each cohort trimmed to its first and last such cell, the
+    cells between them that do not exceed it zeroed, cohorts with none dropped.  The new
+    layout is written over the first entries of ``j0``, ``nn``, ``off``, with ``keep`` the
+    old index of each kept cohort, the cells to ``q_out``, ``m_out``.  Returns the number
+    of cohorts kept, of cells kept and the mass dropped."""
+    p = 0
+    i = 0
+    dropped = 0.0
+    for c in range(n):
+        k, o = nn[c], off[c]
+        a = -1
+        b = -1
+        total = 0.0
+        for s in range(k):
+            total += cell[o + s]
+            if cell[o + s] > floor:
+                if a < 0:
+                    a = s
+                b = s + 1
+        if a < 0:
+            dropped += total
+            continue
+        for s in range(a, b):
+            src = o + s
+            dst = p + s - a
+            if cell[src] > floor:
+                q_out[2 * dst] = q[2 * src]
+                q_out[2 * dst + 1] = q[2 * src + 1]
+                total -= cell[src]
+            else:
+                q_out[2 * dst] = 0.0
+                q_out[2 * dst + 1] = 0.0
+            for r in range(4):
+                m_out[4 * dst + r] = m[4 * src + r]
+        dropped += total
+        keep[i] = c
+        j0[i] = j0[c] + a
+        nn[i] = b - a
+        off[i] = p
+        p += b - a
+        i += 1
+    return i, p, dropped

@@ -212,25 +212,12 @@ class _Cohorts:
         cells' masses, if known."""
         cell = self.cell_masses() if cell is None else cell
         q, m = np.zeros_like(self.q), np.zeros_like(self.m)
-        p = i = 0
-        for c in range(self.n):
-            k, o = self.nn[c], self.off[c]
-            alive = np.flatnonzero(cell[o:o + k] > CELL_FLOOR)
-            self.dropped += float(cell[o:o + k].sum() - cell[o:o + k][alive].sum())
-            if alive.size == 0:
-                continue
-            a, b = alive[0], alive[-1] + 1
-            k = b - a
-            q[2 * p:2 * (p + k)] = self.q[2 * (o + a):2 * (o + b)]
-            m[4 * p:4 * (p + k)] = self.m[4 * (o + a):4 * (o + b)]
-            dead = np.setdiff1d(np.arange(a, b), alive) - a
-            q[2 * (p + dead)] = 0.0
-            q[2 * (p + dead) + 1] = 0.0
-            for name in ("t0", "X0", "s0", "J"):
-                getattr(self, name)[i] = getattr(self, name)[c]
-            self.j0[i], self.nn[i], self.off[i] = self.j0[c] + a, k, p
-            p += k
-            i += 1
+        keep = np.empty(max(self.n, 1), np.int64)
+        i, p, dropped = CK.compact(self.n, self.j0, self.nn, self.off, self.q, self.m, cell, CELL_FLOOR, keep, q, m)
+        for name in ("t0", "X0", "s0", "J"):
+            column = getattr(self, name)
+            column[:i] = column[keep[:i]]
+        self.dropped += dropped
         self.q, self.m, self.pool, self.n = q, m, p, i
 
     # -------------------------------------------------------------- dynamics
@@ -389,7 +376,8 @@ def _peak_before(st: _Cohorts, t_start: float, dt: float) -> float:
     before the shock (like (t* - t)^(-1/2)), the stress peaks within a step of the
     start, between the regular steps' ends.  The replay only measures; the cycle goes on
     from the regular steps (a graded mesh in the cycle itself would make the map
-    discontinuous in where the start falls)."""
+    discontinuous in where the start falls).  The replay stops at the first step in which
+    the stress falls."""
     peak = st.sigma
     rest = t_start - st.t
     while rest > FOLD_TOL * dt:
@@ -399,7 +387,12 @@ def _peak_before(st: _Cohorts, t_start: float, dt: float) -> float:
         if status != 0:
             rest = step
             continue
+        before = st.sigma
         st.commit(x, step, phi, Edt)
+        if st.sigma < before:
+            # the creep outran the drive in this step: it only accelerates towards the
+            # fold, so the stress falls from here on and the peak is behind
+            break
         peak = max(peak, st.sigma)
         rest -= step
     return peak
