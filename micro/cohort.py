@@ -61,10 +61,13 @@ PEAK_CREEP = 0.2
 #: Where the replay found the peak less than this above the stress at the shock's start
 #: (total shocks, small k0: 1e-12 and less), the next cycles of the run skip it.
 PEAK_FLOOR = 1e-10
-#: The time step is cut so that a loading phase has at least this many steps.
-STEPS_PER_CYCLE = 50
-#: Anderson's acceleration (close to V^c): the window, and the evaluations without progress
-#: after which it stops.
+#: A loading phase shorter than this is resolved with steps ``dt * T / SHORT_PHASE`` (T its
+#: length): 50 steps at the default dt = 0.01, twice as many at half the dt (so that
+#: halving dt refines close to V^c too).
+SHORT_PHASE = 0.5
+#: Anderson's acceleration (close to V^c): the window, and the evaluations after which it
+#: stops if they did not halve the smallest residual (a floor of the map's noise, or modes
+#: the window does not catch: the plain cycles that verify its result finish the work).
 ANDERSON_WINDOW = 10
 ANDERSON_STALL = 8
 #: Anderson's map drops the blocks a shock leaves unjumped: it is used only where they are
@@ -317,14 +320,14 @@ def _continued(start, model: Model, V: float, h: float) -> _Cohorts | None:
     return state.moved(V, h)
 
 
-def _step_too_long(period: float, dt: float) -> bool:
-    """Whether a loading phase of ``period`` has too few steps of ``dt``: fewer than 0.8
-    STEPS_PER_CYCLE (not at every small change of the period: each cut of the step
-    restarts the cycle sequence)."""
-    return period < 0.8 * STEPS_PER_CYCLE * dt
+def _step_too_long(period: float, step: float, dt: float) -> bool:
+    """Whether a loading phase of ``period`` has too few steps of ``step`` for the time
+    step ``dt``: fewer than 0.8 of ``SHORT_PHASE / dt`` (not at every small change of the
+    period: each cut of the step restarts the cycle sequence)."""
+    return period < 0.8 * SHORT_PHASE / dt * step
 
 
-def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol: float,
+def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.ndarray, tol: float,
               max_evals: int) -> tuple[_Cohorts | None, int]:
     """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
     total shock (a product state), for the sequences that contract slowly (close to V^c).
@@ -332,7 +335,10 @@ def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol:
     One evaluation is one cycle from a product state; the blocks its shock leaves unjumped
     (at most ANDERSON_UNJUMPED of the mass) are dropped.  Type-II Anderson
     mixing with a window of ANDERSON_WINDOW, stopped when a cycle moves less than ``tol``
-    of the mass, or when ANDERSON_STALL evaluations did not improve on the best one.
+    of the mass, or when ANDERSON_STALL evaluations did not halve the smallest residual
+    (close to V^c at k0 = 0.01 the residual levels off at 1.2e-4 of the mass while
+    sigma_max moves by 2e-6 an evaluation: going on to the last small improvements cost
+    50 evaluations).
     Returns the state after the best evaluation's cycle (its newborn marginal the best
     image, with the blocks that cycle's shock left: a state of the full dynamics), or None
     if the map does not apply, and the evaluations used.
@@ -340,18 +346,20 @@ def _anderson(model: Model, V: float, h: float, dt: float, dep: np.ndarray, tol:
     xs: list[np.ndarray] = []
     gs: list[np.ndarray] = []
     x, best, best_f = dep / dep.sum(), None, math.inf
-    since = 0
+    since, mark = 0, math.inf  # (evaluations since the residual was last halved, and that residual)
     for k in range(1, max_evals + 1):
         st = _start(model, V, h, None, dep=x)
-        out = _one_cycle(st, dt)
-        if not out["ok"] or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], dt):
+        out = _one_cycle(st, step)
+        if not out["ok"] or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
             return best, k
         g = st.dense(st.n - 1)
         g /= g.sum()
         f = float(np.abs(g - x).sum())
         log.debug("anderson %d: sigma_max %.10f, the cycle moves %.2e of the mass", k, out["sigma_max"], f)
         if f < best_f:
-            best, best_f, since = st, f, 0
+            best, best_f = st, f
+        if f <= 0.5 * mark:
+            mark, since = f, 0
         else:
             since += 1
         if best_f <= tol or since >= ANDERSON_STALL:
@@ -545,7 +553,8 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     accelerated by Anderson's method (:func:`_anderson`) and the result verified by plain
     cycles again.  ``error`` is the error of the fixed point at this ``dt`` and
     ``h``, not their discretisation error (``h`` defaults to ``kappa zbar / 20``).  ``dt``
-    is cut to a fiftieth of the loading phase where that is shorter (close to V^c).
+    is the step of loading phases longer than SHORT_PHASE; shorter ones (close to V^c)
+    get steps ``dt * T / SHORT_PHASE`` (a fiftieth of T at the default dt).
     ``eps`` in the result is ``h``.
     """
     begin = time.perf_counter()
@@ -561,6 +570,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         raise ValueError(f"max_iter must be an integer >= 4, got {max_iter!r}")
     given = start if start is not None and start is not _NO_COARSE else None
     st = _continued(given, model, V, h)
+    step = dt
     if st is None and start is not _NO_COARSE and (given is None or given.p is None) \
             and h <= 0.5 * model.kappa * model.zbar:
         # the transient cycles at twice the steps and cells (an eighth of the cost), to a
@@ -571,7 +581,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if coarse.applicable:
             st = _continued(coarse, model, V, h)
             if st is not None:
-                dt = min(dt, st.dt)  # (a step cut to the loading phase stays cut)
+                step = min(dt, 0.5 * st.dt)  # (a step cut to the loading phase stays cut)
             elif coarse.p is not None:
                 given = coarse
     if st is None:
@@ -583,7 +593,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     it, accelerated, passed = 0, False, 0
     while it < max_iter:
         it += 1
-        out = _one_cycle(st, dt)
+        out = _one_cycle(st, step)
         if not out["ok"]:
             applicable, message = False, out["message"]
             break
@@ -597,10 +607,10 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if not out["period"] > 1e-9:
             applicable, message = False, "a shock started with no loading phase (the state is past its fold)"
             break
-        if _step_too_long(out["period"], dt):
-            # close to V^c the loading phase is short: resolve it with STEPS_PER_CYCLE
+        if _step_too_long(out["period"], step, dt):
+            # close to V^c the loading phase is short: resolve it with SHORT_PHASE / dt
             # steps, and start the sequence again at the new step
-            dt = out["period"] / STEPS_PER_CYCLE
+            step = out["period"] * dt / SHORT_PHASE
             hist.clear()
             passed = 0
             continue
@@ -616,7 +626,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             # a product state contracting slowly (close to V^c): accelerate it,
             # then verify the result by the plain cycles again
             accelerated = True
-            fast, used = _anderson(model, V, h, dt, st.dense(st.n - 1), tol, int(max_iter) - it)
+            fast, used = _anderson(model, V, h, step, dt, st.dense(st.n - 1), tol, int(max_iter) - it)
             it += used
             if fast is not None:
                 st = fast
@@ -643,7 +653,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         wall_time=time.perf_counter() - begin, applicable=applicable, history=values,
         sigma_before=float(value[4]), sigma_after=float(value[5]))
     if applicable and len(hist):
-        st.dt = dt
+        st.dt = step
         res.state = st
         if st.n == 1:  # (after a total shock the state is its delta_R marginal)
             res.p = st.marginal(0)

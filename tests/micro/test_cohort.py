@@ -161,7 +161,7 @@ def test_anderson_beats_the_plain_cycles_close_to_vc():
         g = s.dense(s.n - 1)
         return np.abs(g / g.sum() - x / x.sum()).sum()
 
-    state, used = _anderson(model, V, h, dt, x0, 1e-12, 15)
+    state, used = _anderson(model, V, h, dt, 0.01, x0, 1e-12, 15)
     assert state is not None and used == 15
     fast = state.dense(state.n - 1)
     st = _start(model, V, h, None, dep=x0)
