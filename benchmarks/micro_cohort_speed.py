@@ -60,7 +60,8 @@ def main() -> None:
         model = micro.Model(k0=k0)
         Vc = micro.critical_velocity(model).Vc
         for frac in (float(v) for v in args.fractions.split(",")):
-            row = dict(k0=k0, Vc=Vc, V_over_Vc=frac, V=frac * Vc, tol=args.tol, **run(model, frac * Vc, args.tol))
+            row = dict(k0=k0, Vc=Vc, V_over_Vc=frac, V=frac * Vc, tol=args.tol, threads=numba.get_num_threads(),
+                       **run(model, frac * Vc, args.tol))
             if args.reference:
                 ref = run(model, frac * Vc, args.ref_tol)
                 row.update({f"ref_{name}": ref[name] for name in QUANTITIES})
