@@ -141,9 +141,12 @@ def test_killed_run_leaves_no_worker_behind(sig, tmp_path):
     import signal
 
     env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    # (a run started in the background by a non-interactive shell inherits SIGINT ignored,
+    # and Python then installs no Ctrl-C handler: give the child the default, as a terminal would)
     proc = subprocess.Popen([sys.executable, "-m", "compare", "--quick", "--no-progress", "--workers", "2",
                              "--out", str(tmp_path / "r"), "--cache-dir", str(tmp_path / "c")],
-                            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + 120
         while len(_children(proc.pid)) < 2 and time.monotonic() < deadline and proc.poll() is None:
