@@ -337,7 +337,7 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.
     of the mass, or when ANDERSON_STALL evaluations did not improve on the best one.
     (Stopping sooner, when 8 evaluations did not halve the residual, left the plain
     cycles a mixture of modes that Aitken's extrapolation misjudged: at k0 = 1e-3,
-    0.95 V^c, continued from 0.9 V^c, sigma_max 8e-5 off with 4e-6 claimed.)
+    0.95 V^c, continued from 0.9 V^c, sigma_max 1e-4 off with 4e-6 claimed.)
     Returns the state after the best evaluation's cycle (its newborn marginal the best
     image, with the blocks that cycle's shock left: a state of the full dynamics), or None
     if the map does not apply, and the evaluations used.
