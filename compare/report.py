@@ -135,9 +135,7 @@ class _Study:
             tasks += [VcTask(s.model(k0, k1, k2)) for k1, k2 in s.phase_sets for k0 in self._phase_k0(k2)]
         tasks += self._branch_tasks()
         if "bifurcation" in scenarios:
-            tasks += self._diagram_tasks(fitted=self.Dc_given is None)
-        if "bifurcation" in scenarios:
-            tasks += self._paper_tasks()
+            tasks += self._diagram_tasks(fitted=self.Dc_given is None) + self._paper_tasks()
         if "hopf" in scenarios:
             tasks += self._hopf_tasks()
         if "phase" in scenarios:
@@ -284,14 +282,16 @@ class _Study:
         return [self._cycle_task(k0, r) for k0, r in pairs if self.Vc(k0) > 0]
 
     def _points(self, pairs, role: str) -> pd.DataFrame:
-        return micro_frame(self._run(self._cycle_tasks(pairs), "micro stick-slip"), role=role,
-                           method=self.s.cycle_method)
+        """The stick-slip cycles at ``pairs`` (k0, V / V^c), with their k0's V^c."""
+        frame = micro_frame(self._run(self._cycle_tasks(pairs), "micro stick-slip"), role=role,
+                            method=self.s.cycle_method)
+        frame["Vc"] = [self.Vc(k) for k in frame.k0]
+        return frame
 
     @cached_property
     def shown_points(self) -> pd.DataFrame:
         """Micro's stick-slip points that the diagram shows but the D_c fit does not match."""
         frame = self._points(self.s.shown_points, "shown")
-        frame["Vc"] = [self.Vc(k) for k in frame.k0]
         self.tables["micro_shown_points"] = frame
         return frame
 
@@ -301,7 +301,6 @@ class _Study:
         D_c fit matches."""
         s = self.s
         frame = self._points(s.fp_points, "diagram")
-        frame["Vc"] = [self.Vc(k) for k in frame.k0]
         rows = []
         for k0 in s.fp_k0:
             vc = self.Vc(k0)
