@@ -1,9 +1,10 @@
 """The stick-slip amplitude against V^c - V by the cohort method (``micro.cohort``).
 
 Fig. 4 parameters, k0 = 0.1 and 0.01, V / V^c from 0.5 to 0.999 with the exact V^c of
-the renewal chain; each V starts from the previous V's cycle (its whole state), converged to tol = 1e-6 at (dt, h) = (0.01, kappa zbar / 20), and again at
-(0.005, kappa zbar / 40) to measure the discretisation error of each amplitude (``--dt``
-sets the levels, each with h = 5 kappa zbar dt).  The law is reported as the local
+the renewal chain; each V starts from the previous V's cycle (its whole state),
+converged to tol = 1e-6 at (dt, h) = (0.01, kappa zbar / 20), and again at (0.005,
+kappa zbar / 40) to measure the discretisation error of each amplitude (``--dt`` sets the
+levels, each with h = 5 kappa zbar dt).  The law is reported as the local
 exponents d log(amplitude) / d log(1 - V/V^c) between neighbouring V, at each level.
 
 Writes benchmarks/results/micro_cohort_amplitude.csv, a row at a time (rows merge by k0,
@@ -93,6 +94,7 @@ def main() -> None:
             nu = local_exponents(grp.V_over_Vc.to_numpy(), grp.amplitude.to_numpy())
             pairs = ", ".join(f"{a:g}-{b:g}: {v:.3f}" for a, b, v in zip(grp.V_over_Vc, grp.V_over_Vc[1:], nu))
             print(f"k0 = {k0:g}, dt = {dt:g}: local exponents of the amplitude between V/Vc {pairs}")
+
 
 if __name__ == "__main__":
     main()
