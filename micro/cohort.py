@@ -231,13 +231,13 @@ class _Cohorts:
 
     def closure(self, dX: float) -> tuple[float, float]:
         return CK.closure(dX, self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
-                          self.lam, self.model.zbar, _GX, _GW)
+                          self.lam, self.model.zbar)
 
     def root(self) -> tuple[float, int]:
         """The step's slip (after :meth:`prepare`) and 0, or 1 if the step starts a shock."""
         xmin = max(1e-9 * self.model.zbar, 0.25 * self.last)
         return CK.smallest_root(self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
-                                self.lam, self.model.zbar, _GX, _GW, 1e-15 * self.model.zbar, xmin)
+                                self.lam, self.model.zbar, 1e-15 * self.model.zbar, xmin)
 
     def commit(self, dX: float, dt: float, phi: float, Edt: float) -> None:
         md = self.model
