@@ -214,10 +214,10 @@ def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar):
     First crossings are integrated exactly over each cell's crossed part; a block that
     crossed jumps again as a Poisson process of rate 1/lam in its margin's overshoot
     (exponential jumps), also integrated exactly.  (By two Gauss-Legendre points, as
-    before, the re-jumps of a shock at small k0, hundreds per block, were off by about
-    1e-6 of the slip: every block's lag then moved from the mean slip, which nothing in
-    the dynamics restores, and at k0 = 1e-4 the cycle's stress kept an offset of up to
-    1e-4 that depended on the start.)
+    before, the re-jumps of a shock at small k0, some 7000 per block at k0 = 1e-4, were
+    off by about 1e-6 of the slip: every block's lag then moved from the mean slip,
+    which nothing in the dynamics restores, and at k0 = 1e-4 the cycle's stress kept
+    an offset of up to 1e-4 that depended on the start.)
     The cohorts are summed in CHUNKS interleaved chunks, in parallel when there are at
     least PARALLEL_COHORTS of them (the same sums in the same order either way)."""
     parts = np.zeros((CHUNKS, 2))

@@ -48,6 +48,20 @@ def test_a_shock_keeps_the_mean_lag_at_zero():
         assert abs(st.sigma - lagged) < 1e-8
 
 
+def test_a_run_close_to_vc_says_its_estimate_can_miss_a_slow_mode():
+    """Close to V^c the cycles contract by 0.9-0.98 a cycle, and five cycles can hide a
+    mode slower than the one they show: at k0 = 1e-3, 0.95 V^c the estimate was measured
+    25 times too small (benchmarks/micro_cohort_estimate_check.py).  Such a run says so;
+    one far from V^c does not."""
+    model = micro.Model(k0=0.001)
+    Vc = micro.critical_velocity(model).Vc
+    coarse = dict(dt=0.04, h=model.kappa * model.zbar / 5, tol=1e-4, start=_NO_COARSE)
+    near = cycle_cohorts(model, 0.95 * Vc, **coarse)
+    assert near.converged and "can hide a slower mode" in near.message, near.message
+    far = cycle_cohorts(model, 0.3 * Vc, **coarse)
+    assert far.converged and "slower mode" not in far.message, far.message
+
+
 @pytest.mark.parametrize("W", [0.03, math.inf])
 def test_deposit_keeps_mass_and_mean(W):
     """The hat-function deposit of Y = ytop - B Z, Z ~ Exp(lam) on [0, W], keeps the mass
