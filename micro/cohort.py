@@ -15,9 +15,11 @@ rest.  So the blocks born in one step (a *cohort*) are Exp(kappa zbar) in
 jumped again are those above a floor :math:`\delta' > m(\delta_R')`.  Nothing is
 discretised in the margin: a cohort's density is piecewise linear on cells of width
 ``h`` in delta_R, each cell with a floor that is linear or has one kink, and every
-crossed mass is an exact integral of an exponential.  A step of length ``dt`` solves the mean-field closure for its
-slip (``dX = zbar x`` the jumps it causes, a crossed block jumping again as a Poisson
-process of its overshoot); the loading phase ends where the closure's smallest root
+crossed mass is an exact integral of an exponential.  A step of length ``dt`` (up to
+four times longer in the middle of a loading phase many relaxation times long:
+:func:`_step_length`) solves the mean-field closure for its slip (``dX = zbar x`` the
+jumps it causes, a crossed block jumping again as a Poisson process of its overshoot);
+the loading phase ends where the closure's smallest root
 jumps (a fold), located by bisecting the step; the shock is the same closure in zero
 time.  Where a near-critical avalanche runs away is then a continuous function of the
 state, so the cycle-to-cycle sequence converges smoothly (geometrically) and is
@@ -65,6 +67,14 @@ PEAK_FLOOR = 1e-10
 #: length): 50 steps at the default dt = 0.01, twice as many at half the dt (so that
 #: halving dt refines close to V^c too).
 SHORT_PHASE = 0.5
+#: Long loading phases are graded: a step ``dt`` within ``1 / gamma`` (the dashpots'
+#: relaxation time) of the shock before and of the loading phase's end, longer in between
+#: (``dt`` times the distance to the nearer end in units of ``1 / gamma``, at most
+#: GRADED_MAX times ``dt``; :func:`_step_length`).  The end is that of a reference loading
+#: phase, kept until a loading phase differs from it by more than GRADED_SLACK / gamma (a
+#: grid that followed every cycle's length would feed back on the shock's start).
+GRADED_MAX = 4.0
+GRADED_SLACK = 0.25
 #: Anderson's acceleration (close to V^c): the window, and the evaluations without progress
 #: after which it stops.
 ANDERSON_WINDOW = 10
@@ -106,6 +116,7 @@ class _Cohorts:
         self.dropped = 0.0  # the mass of the cells dropped by compact()
         self.dt = math.nan  # the time step of the run that left this state
         self.peak_excess = math.inf  # how far the stress peaked above its value at the last shock's start
+        self.period_ref = 0.0  # the loading phase the steps are graded to (0: none yet, uniform steps)
 
     # -------------------------------------------------------------- storage
     def add(self, dep: np.ndarray) -> None:
@@ -181,6 +192,7 @@ class _Cohorts:
             if hi > lo:
                 st._append((self.t0[c], self.X0[c], self.s0[c], self.J[c]), j0 + lo, q[lo:hi], m[lo:hi])
         st.t, st.X, st.sigma, st.last, st.dt = self.t, self.X, self.sigma, self.last, self.dt
+        st.period_ref = self.period_ref
         st.dropped = self.dropped
         return st
 
@@ -331,12 +343,20 @@ def _step_too_long(period: float, step: float, dt: float) -> bool:
     return period < 0.8 * SHORT_PHASE / dt * step
 
 
-def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.ndarray, tol: float,
-              max_evals: int) -> tuple[_Cohorts | None, int]:
+def _step_length(since: float, ref: float, dt: float, gamma: float) -> float:
+    """The loading phase's step at time ``since`` after the last shock, graded to a loading
+    phase of length ``ref`` (GRADED_MAX).  A function of the step's start only, so halving
+    ``dt`` halves every step."""
+    return dt * min(GRADED_MAX, max(1.0, gamma * min(since, ref - since)))
+
+
+def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.ndarray, ref: float,
+              tol: float, max_evals: int) -> tuple[_Cohorts | None, int]:
     """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
     total shock (a product state), for the sequences that contract slowly (close to V^c).
 
-    One evaluation is one cycle from a product state; the blocks its shock leaves unjumped
+    One evaluation is one cycle from a product state (its steps graded to the loading
+    phase ``ref``); the blocks its shock leaves unjumped
     (at most ANDERSON_UNJUMPED of the mass) are dropped.  Type-II Anderson
     mixing with a window of ANDERSON_WINDOW, stopped when a cycle moves less than ``tol``
     of the mass, or when ANDERSON_STALL evaluations did not improve on the best one.
@@ -353,6 +373,7 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.
     since = 0
     for k in range(1, max_evals + 1):
         st = _start(model, V, h, None, dep=x)
+        st.period_ref = ref
         out = _one_cycle(st, step)
         if not out["ok"] or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
             return best, k
@@ -409,7 +430,8 @@ def _peak_before(st: _Cohorts, t_start: float, dt: float) -> float:
 
 
 def _one_cycle(st: _Cohorts, dt: float) -> dict:
-    """Load in steps of ``dt`` until a step starts a shock, locate the shock's start by
+    """Load in steps of ``dt`` (longer ones in the middle of a long loading phase:
+    :func:`_step_length`) until a step starts a shock, locate the shock's start by
     bisecting that step (one partial step up to it: the cycle map stays continuous in
     where the start falls), then apply the shock.
 
@@ -426,6 +448,7 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     snapshot = None
     replay = st.peak_excess > PEAK_FLOOR
     t_max = 20.0 * st.lam / (st.model.k0 * st.V)
+    gamma = st.model.gamma
 
     def advance(x, length, phi, Edt):
         nonlocal integral, peak, trough
@@ -437,19 +460,20 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     while True:
         if st.t - t_start > t_max:
             return dict(ok=False, message=f"no shock within t = {t_max:.3g} of the last one")
-        phi, Edt = st.prepare(dt)
+        step = _step_length(st.t - t_start, st.period_ref, dt, gamma)
+        phi, Edt = st.prepare(step)
         x, status = st.root()
         if status == 2:
             return dict(ok=False, message="the closure of a step did not converge")
         if status == 0:
             # keep the state before a step in which the creep approaches the drive: the
             # stress may peak in it, or in the next one, close to the shock's start
-            snapshot = st.copy() if replay and x > PEAK_CREEP * st.V * dt else None
-            advance(x, dt, phi, Edt)
+            snapshot = st.copy() if replay and x > PEAK_CREEP * st.V * step else None
+            advance(x, step, phi, Edt)
             continue
         here = st.copy() if replay and snapshot is None else None
-        lo, hi = 0.0, dt
-        while hi - lo > FOLD_TOL * dt:
+        lo, hi = 0.0, step
+        while hi - lo > FOLD_TOL * step:
             mid = 0.5 * (lo + hi)
             st.prepare(mid)
             if st.root()[1] == 0:
@@ -466,6 +490,8 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
             peak = max(peak, fine)
         break
     sigma_before, period = st.sigma, st.t - t_start
+    if abs(period - st.period_ref) > GRADED_SLACK / gamma:
+        st.period_ref = period
     st.prepare(0.0)
     x, _ = st.root()
     n_old = st.n
@@ -556,8 +582,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     cycles again.  ``error`` is the error of the fixed point at this ``dt`` and
     ``h`` (close to V^c it can miss a slower mode and be several times too small: the
     message then says so), not their discretisation error (``h`` defaults to ``kappa zbar / 20``).  ``dt``
-    is the step of loading phases longer than SHORT_PHASE; shorter ones (close to V^c)
-    get steps ``dt * T / SHORT_PHASE`` (a fiftieth of T at the default dt).
+    is the step of loading phases longer than SHORT_PHASE, within ``1 / gamma`` of their
+    ends (up to four times longer between: :func:`_step_length`); shorter ones (close to
+    V^c) get steps ``dt * T / SHORT_PHASE`` (a fiftieth of T at the default dt).
     ``eps`` in the result is ``h``.
     """
     begin = time.perf_counter()
@@ -629,7 +656,8 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             # a product state contracting slowly (close to V^c): accelerate it,
             # then verify the result by the plain cycles again
             accelerated = True
-            fast, used = _anderson(model, V, h, step, dt, st.dense(st.n - 1), tol, int(max_iter) - it)
+            fast, used = _anderson(model, V, h, step, dt, st.dense(st.n - 1), st.period_ref, tol,
+                                    int(max_iter) - it)
             it += used
             if fast is not None:
                 st = fast
