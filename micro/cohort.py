@@ -63,10 +63,9 @@ PEAK_CREEP = 0.2
 #: Where the replay found the peak less than this above the stress at the shock's start
 #: (total shocks, small k0: 1e-12 and less), the next cycles of the run skip it.
 PEAK_FLOOR = 1e-10
-#: A loading phase shorter than this is resolved with n = SHORT_PHASE / dt steps of
-#: ``T / (n + 1/2)``, T the last loading phase's length (:func:`_short_step`): 50 steps
-#: at the default dt = 0.01, twice as many at half the dt (so that halving dt refines
-#: close to V^c too).
+#: A loading phase shorter than this is resolved with steps ``dt * T / SHORT_PHASE`` (T its
+#: length): 50 steps at the default dt = 0.01, twice as many at half the dt (so that
+#: halving dt refines close to V^c too).
 SHORT_PHASE = 0.5
 #: Long loading phases are graded: a step ``dt`` within ``1 / gamma`` (the dashpots'
 #: relaxation time) of the shock before and of the loading phase's end, longer in between
@@ -351,24 +350,13 @@ def _step_length(since: float, ref: float, dt: float, gamma: float) -> float:
     return dt * min(GRADED_MAX, max(1.0, gamma * min(since, ref - since)))
 
 
-def _short_step(period: float, dt: float) -> float:
-    """The step of a short loading phase (close to V^c) after one of length ``period``:
-    ``period / (n + 1/2)``, n = SHORT_PHASE / dt, at most ``dt``.  At the fixed point the
-    shock then starts in the middle of step n + 1, half a step from the boundaries where
-    the number of whole steps changes and the cycle map has a kink (a fixed step put the
-    start anywhere in its step; measured in docs/reference/micro_cohort.md, section 4)."""
-    n = max(1, round(SHORT_PHASE / dt))
-    return min(dt, period / (n + 0.5))
-
-
 def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.ndarray, ref: float,
               tol: float, max_evals: int) -> tuple[_Cohorts | None, int]:
     """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
     total shock (a product state), for the sequences that contract slowly (close to V^c).
 
     One evaluation is one cycle from a product state (its steps graded to the loading
-    phase ``ref``; a ``step`` below ``dt``, cut to a short loading phase, follows each
-    evaluation's loading phase by :func:`_short_step`); the blocks its shock leaves unjumped
+    phase ``ref``); the blocks its shock leaves unjumped
     (at most ANDERSON_UNJUMPED of the mass) are dropped.  Type-II Anderson
     mixing with a window of ANDERSON_WINDOW, stopped when a cycle moves less than ``tol``
     of the mass, or when ANDERSON_STALL evaluations did not improve on the best one.
@@ -389,8 +377,6 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.
         out = _one_cycle(st, step)
         if not out["ok"] or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
             return best, k
-        if step < dt:
-            step = _short_step(out["period"], dt)
         g = st.dense(st.n - 1)
         g /= g.sum()
         f = float(np.abs(g - x).sum())
@@ -598,8 +584,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     message then says so), not their discretisation error (``h`` defaults to ``kappa zbar / 20``).  ``dt``
     is the step of loading phases longer than SHORT_PHASE, within ``1 / gamma`` of their
     ends (up to four times longer between: :func:`_step_length`); shorter ones (close to
-    V^c) get about SHORT_PHASE / dt steps (50 at the default dt), aligned so that the
-    shock starts in the middle of a step (:func:`_short_step`).
+    V^c) get steps ``dt * T / SHORT_PHASE`` (a fiftieth of T at the default dt).
     ``eps`` in the result is ``h``.
     """
     begin = time.perf_counter()
@@ -655,12 +640,10 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if _step_too_long(out["period"], step, dt):
             # close to V^c the loading phase is short: resolve it with SHORT_PHASE / dt
             # steps, and start the sequence again at the new step
-            step = _short_step(out["period"], dt)
+            step = out["period"] * dt / SHORT_PHASE
             hist.clear()
             passed = 0
             continue
-        if step < dt:  # (a step cut to a short loading phase follows it)
-            step = _short_step(out["period"], dt)
         hist.append(tuple(out[name] for name in COLUMNS))
         log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f", it, out["sigma_max"],
                   out["sigma_min"], out["sigma_before"])

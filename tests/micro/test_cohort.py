@@ -58,22 +58,6 @@ def test_a_long_loading_phase_takes_longer_steps_in_its_middle(monkeypatch):
         assert graded[name] == pytest.approx(uniform[name], abs=2e-6)
 
 
-def test_close_to_vc_the_shock_starts_in_the_middle_of_a_step():
-    # k0 = 0.1, 0.9 V^c: a loading phase of about 0.34 gets n = 0.5 / dt = 12 steps of
-    # T / 12.5 (T the last loading phase's), so the next shock starts half a step from the
-    # boundaries where the number of whole steps, and the cycle map's derivative, jump
-    from micro import cohort
-    model = micro.Model(k0=0.1)
-    V = 0.9 * micro.critical_velocity(model).Vc
-    res = cycle_cohorts(model, V, dt=0.04, h=model.kappa * model.zbar / 5.0, tol=1e-4)
-    assert res.converged
-    step = res.state.dt
-    assert step == pytest.approx(cohort._short_step(res.history[-1, 2], 0.04)) and step < 0.04
-    out = _one_cycle(res.state.copy(), step)
-    assert out["ok"]
-    assert 0.25 < out["period"] / step - 12 < 0.75
-
-
 def test_a_shock_keeps_the_mean_lag_at_zero():
     """The blocks' mean lag behind the mean slip is zero at all times (the mean slip is
     their mean displacement).  After a total shock every margin is Exp(kappa zbar), so
