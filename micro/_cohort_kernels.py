@@ -242,16 +242,27 @@ def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar):
 
 
 @njit(cache=True)
-def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, tol, xmin):
+def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, tol, xmin, xguess):
     """The smallest root of H (status 0), or status 1 if H has a positive local minimum
     before it: the slip jumps, a fold (the start of a shock).  Newton from 0 with steps
     capped at doubling (from ``xmin``) so that a minimum is not jumped over, then
     safeguarded Newton in the bracket, to ``1e-13 x + tol`` (``tol``: the round-off of H,
-    a sum over every cell, in units of slip).  Status 2: no convergence."""
+    a sum over every cell, in units of slip).  Status 2: no convergence.
+
+    ``xguess`` > 0 (a point short of the root, from the step before): where H is
+    positive and falling there, Newton starts there instead of from 0 (it would have
+    passed there: the capped steps from 0 jump over as much, so a minimum before it is
+    missed no more than by them); otherwise from 0."""
     x = 0.0
-    H, dH = closure(x, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
-    if H <= 0.0:
-        return 0.0, 0
+    H, dH = -1.0, 0.0
+    if xguess > 0.0:
+        H, dH = closure(xguess, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+        if H > 0.0 and dH < 0.0:
+            x = xguess
+    if x == 0.0:
+        H, dH = closure(x, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+        if H <= 0.0:
+            return 0.0, 0
     for it in range(400):
         if dH >= 0.0:
             return x, 1

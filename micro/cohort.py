@@ -87,6 +87,9 @@ ANDERSON_UNJUMPED = 1e-3
 #: can miss a slower mode (measured: benchmarks/micro_cohort_estimate_check.py).  (Where
 #: the last steps are below tol / 100, a mode contracting by up to 0.99 stays within tol.)
 SLOW_CAVEAT = 0.9
+#: A step's Newton iteration for its slip starts at this fraction of the slip rate
+#: extrapolated from the two steps before, times its length (:meth:`_Cohorts.root`).
+WARM = 0.97
 #: Most cells the cohorts may hold (about 50 MB).
 MAX_CELLS = 3_000_000
 #: A last step d between cycles leaves at most STILL * d to go when they contract by 0.8 a cycle.
@@ -112,6 +115,9 @@ class _Cohorts:
         self.n = self.pool = 0
         self.t = self.X = self.sigma = 0.0
         self.last = 0.0
+        self.last_dt = 0.0  # the length of the step that slipped ``last``
+        self.prev_rate = 0.0  # the slip rate of the step before that
+        self.pending = 0.0  # the length of the step being prepared
         self.outside = 0.0
         self.dropped = 0.0  # the mass of the cells dropped by compact()
         self.dt = math.nan  # the time step of the run that left this state
@@ -191,7 +197,8 @@ class _Cohorts:
                 st.outside += float(lost.sum())
             if hi > lo:
                 st._append((self.t0[c], self.X0[c], self.s0[c], self.J[c]), j0 + lo, q[lo:hi], m[lo:hi])
-        st.t, st.X, st.sigma, st.last, st.dt = self.t, self.X, self.sigma, self.last, self.dt
+        st.t, st.X, st.sigma, st.last, st.last_dt, st.dt = self.t, self.X, self.sigma, self.last, self.last_dt, self.dt
+        st.prev_rate = self.prev_rate
         st.period_ref = self.period_ref
         st.dropped = self.dropped
         return st
@@ -242,6 +249,7 @@ class _Cohorts:
     # -------------------------------------------------------------- dynamics
     def prepare(self, dt: float) -> tuple[float, float]:
         md = self.model
+        self.pending = dt
         return CK.coefficients(self.t, dt, self.X, self.sigma, self.V, md.k0, md.k1, md.k2, md.f_th, md.gamma,
                                self.t0, self.X0, self.s0, self.J, self.n, self.co, self.j0, self.nn, self.off,
                                self.q, self.m, self.ylo, self.h)
@@ -250,11 +258,18 @@ class _Cohorts:
         return CK.closure(dX, self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
                           self.lam, self.model.zbar)
 
-    def root(self) -> tuple[float, int]:
-        """The step's slip (after :meth:`prepare`) and 0, or 1 if the step starts a shock."""
+    def root(self, below: float = 0.0) -> tuple[float, int]:
+        """The step's slip (after :meth:`prepare`) and 0, or 1 if the step starts a shock.
+        ``below``: a slip known to be short of the root (0: none), where Newton starts;
+        otherwise it starts at WARM times the slip rate extrapolated from the last two
+        steps, times this step."""
         xmin = max(1e-9 * self.model.zbar, 0.25 * self.last)
+        guess = below
+        if guess <= 0.0 and self.last_dt > 0.0 and self.prev_rate > 0.0:
+            rate = self.last / self.last_dt
+            guess = WARM * rate * min(rate / self.prev_rate, 2.0) * self.pending
         return CK.smallest_root(self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
-                                self.lam, self.model.zbar, 1e-15 * self.model.zbar, xmin)
+                                self.lam, self.model.zbar, 1e-15 * self.model.zbar, xmin, guess)
 
     def commit(self, dX: float, dt: float, phi: float, Edt: float) -> None:
         md = self.model
@@ -263,7 +278,8 @@ class _Cohorts:
                                   self.s0, self.X, Edt, phi, self.ylo, self.h, self.lam, md.k2, md.kappa, md.f_th,
                                   _GX, _GW, dep)
         if dt > 0.0:
-            self.last = dX
+            self.prev_rate = self.last / self.last_dt if self.last_dt > 0.0 else 0.0
+            self.last, self.last_dt = dX, dt
         self.t += dt
         self.X += dX
         self.sigma += md.k0 * (self.V * dt - dX)
@@ -271,18 +287,28 @@ class _Cohorts:
 
     def shock_root(self, x0: float) -> float:
         """The slip of the shock: the closure's root beyond its positive minimum (after
-        :meth:`prepare` with dt = 0), bracketed by doubling, then bisected."""
+        :meth:`prepare` with dt = 0), bracketed by doubling, bisected to a hundredth,
+        then safeguarded Newton in the bracket (a bisection step where Newton leaves it)."""
         lo, hi = x0, max(2.0 * x0, self.model.zbar)
         while self.closure(hi)[0] > 0.0:
             lo, hi = hi, 2.0 * hi
             if hi > 1e12:
                 raise RuntimeError("the shock's closure has no root")
+        x = hi
         while hi - lo > 1e-14 * hi:
-            mid = 0.5 * (lo + hi)
-            if self.closure(mid)[0] > 0.0:
-                lo = mid
+            if hi - lo > 1e-2 * hi:
+                x = 0.5 * (lo + hi)
+                H, dH = self.closure(x)
             else:
-                hi = mid
+                step = -H / dH if dH < 0.0 else math.inf
+                if abs(step) <= 1e-14 * x:
+                    return x
+                x = x + step if lo < x + step < hi else 0.5 * (lo + hi)
+                H, dH = self.closure(x)
+            if H > 0.0:
+                lo = x
+            else:
+                hi = x
         return hi
 
 
@@ -472,17 +498,18 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
             advance(x, step, phi, Edt)
             continue
         here = st.copy() if replay and snapshot is None else None
-        lo, hi = 0.0, step
+        lo, hi, x_lo = 0.0, step, 0.0
         while hi - lo > FOLD_TOL * step:
             mid = 0.5 * (lo + hi)
             st.prepare(mid)
-            if st.root()[1] == 0:
-                lo = mid
+            x, status = st.root(below=x_lo)  # (a longer step slips more)
+            if status == 0:
+                lo, x_lo = mid, x
             else:
                 hi = mid
         if lo > 0.0:
             phi, Edt = st.prepare(lo)
-            x, _ = st.root()
+            x, _ = st.root(below=x_lo)
             advance(x, lo, phi, Edt)
         if replay:
             fine = _peak_before(snapshot if snapshot is not None else here, st.t, dt)

@@ -58,6 +58,50 @@ def test_a_long_loading_phase_takes_longer_steps_in_its_middle(monkeypatch):
         assert graded[name] == pytest.approx(uniform[name], abs=2e-6)
 
 
+@pytest.mark.parametrize("k0, frac", [(0.01, 0.5), (1e-4, 0.95)])
+def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
+    """A step's Newton iteration starts from the slip rate of the steps before (the fold's
+    bisection from the slip of its longest step that did not fold), the shock's root by
+    Newton in a bracket a hundredth wide: the same slips and the same folds as Newton from
+    0 and plain bisection (at k0 = 1e-4 the shock's closure is flat, dH = -1e-4, and
+    lands on exactly 0: a first version returned a bisection point there, 1.3 off)."""
+    from micro import cohort
+    model = micro.Model(k0=k0)
+    V = frac * micro.critical_velocity(model).Vc
+    st = _start(model, V, model.kappa * model.zbar / 5.0, None)
+    root, shock_root = cohort._Cohorts.root, cohort._Cohorts.shock_root
+    seen = {"warm": 0, "shocks": 0}
+
+    def checked_root(self, below=0.0):
+        x, status = root(self, below)
+        cold = CK.smallest_root(self.n, self.co, self.j0, self.nn, self.off, self.q, self.m, self.ylo, self.h,
+                                self.lam, model.zbar, 1e-15 * model.zbar,
+                                max(1e-9 * model.zbar, 0.25 * self.last), 0.0)
+        assert status == cold[1]
+        if status == 0:
+            assert x == pytest.approx(cold[0], rel=1e-10)
+            seen["warm"] += below > 0.0 or self.prev_rate > 0.0
+        return x, status
+
+    def checked_shock_root(self, x0):
+        x = shock_root(self, x0)
+        lo, hi = x0, max(2.0 * x0, model.zbar)
+        while self.closure(hi)[0] > 0.0:
+            lo, hi = hi, 2.0 * hi
+        while hi - lo > 1e-14 * hi:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if self.closure(mid)[0] > 0.0 else (lo, mid)
+        assert x == pytest.approx(hi, rel=1e-10)  # (the closure is flat: its round-off moves the root by ~1e-12)
+        seen["shocks"] += 1
+        return x
+
+    monkeypatch.setattr(cohort._Cohorts, "root", checked_root)
+    monkeypatch.setattr(cohort._Cohorts, "shock_root", checked_shock_root)
+    for _ in range(2):
+        assert _one_cycle(st, 0.04 if frac < 0.9 else 0.004)["ok"]
+    assert seen["warm"] > 20 and seen["shocks"] == 2
+
+
 def test_a_shock_keeps_the_mean_lag_at_zero():
     """The blocks' mean lag behind the mean slip is zero at all times (the mean slip is
     their mean displacement).  After a total shock every margin is Exp(kappa zbar), so
