@@ -133,6 +133,19 @@ def test_a_run_close_to_vc_says_its_estimate_can_miss_a_slow_mode():
     assert far.converged and "slower mode" not in far.message, far.message
 
 
+def test_anderson_leaves_the_plain_cycles_half_the_budget():
+    """Below the map's roughness Anderson's residual creeps down without stalling: at
+    k0 = 1e-3, 0.95 V^c and tol = 1e-6 it used to take every cycle left, and the run ended
+    with no plain cycle, no value and an estimate of 6e-3.  It now gets at most half."""
+    model = micro.Model(k0=0.001)
+    V = 0.95 * micro.critical_velocity(model).Vc
+    res = cycle_cohorts(model, V, dt=0.04, h=model.kappa * model.zbar / 5, tol=1e-9, max_iter=60,
+                        start=_NO_COARSE)
+    assert "Anderson" in res.message or not res.converged
+    assert res.iterations <= 60 and len(res.history) >= 20
+    assert math.isfinite(res.sigma_max) and res.sigma_max == pytest.approx(0.9068, abs=1e-3)
+
+
 @pytest.mark.parametrize("W", [0.03, math.inf])
 def test_deposit_keeps_mass_and_mean(W):
     """The hat-function deposit of Y = ytop - B Z, Z ~ Exp(lam) on [0, W], keeps the mass
