@@ -280,6 +280,10 @@ class _Cohorts:
         if dt > 0.0:
             self.prev_rate = self.last / self.last_dt if self.last_dt > 0.0 else 0.0
             self.last, self.last_dt = dX, dt
+        else:
+            # a shock: the creep before it says nothing of the next loading phase's, so
+            # its first two steps start Newton from 0 (``last`` still sets the step cap)
+            self.prev_rate = self.last_dt = 0.0
         self.t += dt
         self.X += dX
         self.sigma += md.k0 * (self.V * dt - dX)
