@@ -12,8 +12,9 @@ sigma_after the stress when the shock starts and right after it.  Each row's
 "distance" is its distance from the extrapolated limit: the error that its run time
 bought.
 
-Writes benchmarks/results/micro_cohort_refinement.csv (rows merge by k0, V / V^c, dt and
-h, so a run with ``--k0 0.3 --fraction 0.5`` alone adds those rows).
+Writes benchmarks/results/micro_cohort_refinement.csv after each level (a point's rows
+replace its old ones, so a run with ``--k0 0.3 --fraction 0.5`` alone adds those rows,
+and an interrupted run keeps the levels it finished).
 
     python benchmarks/micro_cohort_refinement.py        # about 20 minutes on 1 core
 """
@@ -43,6 +44,30 @@ def order_and_limit(s: np.ndarray) -> tuple[float, float]:
     return p, float(s[2] - d2 / (2.0**p - 1.0))
 
 
+def save(rows: list[dict], out: Path) -> None:
+    """Merge ``rows`` into the CSV at ``out`` (a point's rows, by k0 and V / V^c, replace
+    all its old rows, so that a run stopped after one level does not leave it beside
+    levels of an older run) and give every point with all three levels its order, limit
+    and distances (NaN while it has fewer)."""
+    frame = pd.DataFrame(rows)
+    old = pd.read_csv(out) if out.exists() else None
+    if old is not None and set(frame.columns) <= set(old.columns):  # (rows of an older layout are dropped)
+        old = old[list(frame.columns)]
+        key = ["k0", "V_over_Vc"]
+        old = old[~old.set_index(key).index.isin(frame.set_index(key).index)]
+        frame = pd.concat([old, frame], ignore_index=True).sort_values(["k0", "V_over_Vc", "dt"],
+                                                                      ascending=[False, True, False])
+        frame = frame.reset_index(drop=True)
+    for _, grp in frame.groupby(["k0", "V_over_Vc"], sort=False):
+        for col in ("sigma_max", "sigma_min", "sigma_before", "sigma_after"):
+            p, lim = order_and_limit(grp[col].to_numpy()) if len(grp) == len(LEVELS) else (math.nan, math.nan)
+            frame.loc[grp.index, f"{col}_order"] = p
+            frame.loc[grp.index, f"{col}_limit"] = lim
+            frame.loc[grp.index, f"{col}_distance"] = (grp[col] - lim).abs()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(out, index=False)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--k0", default="0.3,0.1,0.01,0.001,0.0001")
@@ -66,25 +91,9 @@ def main() -> None:
                              exact_sigma_min=micro.sigma_fast_limit(model), period=res.period, error=res.error,
                              cycles=res.iterations, converged=res.converged, wall_s=wall))
             print(rows[-1], flush=True)
-    frame = pd.DataFrame(rows)
-    old = pd.read_csv(args.out) if Path(args.out).exists() else None
-    if old is not None and set(frame.columns) <= set(old.columns):  # (rows of an older layout are dropped)
-        old = old[list(frame.columns)]
-        key = ["k0", "V_over_Vc", "dt", "h"]
-        old = old[~old.set_index(key).index.isin(frame.set_index(key).index)]
-        frame = pd.concat([old, frame], ignore_index=True).sort_values(["k0", "V_over_Vc", "dt"],
-                                                                      ascending=[False, True, False])
-        frame = frame.reset_index(drop=True)
-    for _, grp in frame.groupby(["k0", "V_over_Vc"], sort=False):
-        for col in ("sigma_max", "sigma_min", "sigma_before", "sigma_after"):
-            p, lim = order_and_limit(grp[col].to_numpy())
-            frame.loc[grp.index, f"{col}_order"] = p
-            frame.loc[grp.index, f"{col}_limit"] = lim
-            frame.loc[grp.index, f"{col}_distance"] = (grp[col] - lim).abs()
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(args.out, index=False)
+            save(rows, Path(args.out))  # (after each level: an interrupted run keeps its rows)
     with pd.option_context("display.width", 200, "display.max_columns", 30):
-        print(frame)
+        print(pd.read_csv(args.out))
 
 
 if __name__ == "__main__":
