@@ -52,16 +52,13 @@ UNJUMPED = 1e-6
 
 
 def cycle_map(model: micro.Model, V: float, h: float, step: float, ref: float):
-    """G(x): the normalised delta_R marginal after one cycle from the product state with
-    marginal x, and the cycle's row."""
+    """G(x): the method's own map (``micro.cohort._product_cycle``), the normalised delta_R
+    marginal after one cycle from the product state with marginal x, and the cycle's row."""
     def G(x: np.ndarray) -> tuple[np.ndarray, dict]:
-        st = C._start(model, V, h, None, dep=x)
-        st.period_ref = ref
-        out = C._one_cycle(st, step)
-        if not out["ok"]:
+        _, out, g = C._product_cycle(model, V, h, step, ref, x)
+        if g is None:
             raise RuntimeError(out["message"])
-        g = st.dense(st.n - 1)
-        return g / g.sum(), out
+        return g, out
     return G
 
 

@@ -298,9 +298,8 @@ class _Cohorts:
             lo, hi = hi, 2.0 * hi
             if hi > 1e12:
                 raise RuntimeError("the shock's closure has no root")
-        x = hi
         while hi - lo > 1e-14 * hi:
-            if hi - lo > 1e-2 * hi:
+            if hi - lo > 1e-2 * hi:  # (so the first pass bisects, and sets x, H, dH)
                 x = 0.5 * (lo + hi)
                 H, dH = self.closure(x)
             else:
@@ -380,6 +379,21 @@ def _step_length(since: float, ref: float, dt: float, gamma: float) -> float:
     return dt * min(GRADED_MAX, max(1.0, gamma * min(since, ref - since)))
 
 
+def _product_cycle(model: Model, V: float, h: float, step: float, ref: float,
+                   x: np.ndarray) -> tuple[_Cohorts, dict, np.ndarray | None]:
+    """The cycle map on the delta_R marginal after a total shock: one cycle (steps of
+    ``step``, graded to the loading phase ``ref``) from the product state of Exp margins
+    and the marginal ``x``.  Returns the state after it, the cycle's row and the
+    normalised marginal of the blocks its shock made jump (None if the cycle failed)."""
+    st = _start(model, V, h, None, dep=x)
+    st.period_ref = ref
+    out = _one_cycle(st, step)
+    if not out["ok"]:
+        return st, out, None
+    g = st.dense(st.n - 1)
+    return st, out, g / g.sum()
+
+
 def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.ndarray, ref: float,
               tol: float, max_evals: int) -> tuple[_Cohorts | None, int]:
     """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
@@ -402,13 +416,9 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.
     x, best, best_f = dep / dep.sum(), None, math.inf
     since = 0
     for k in range(1, max_evals + 1):
-        st = _start(model, V, h, None, dep=x)
-        st.period_ref = ref
-        out = _one_cycle(st, step)
-        if not out["ok"] or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
+        st, out, g = _product_cycle(model, V, h, step, ref, x)
+        if g is None or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
             return best, k
-        g = st.dense(st.n - 1)
-        g /= g.sum()
         f = float(np.abs(g - x).sum())
         log.debug("anderson %d: sigma_max %.10f, the cycle moves %.2e of the mass", k, out["sigma_max"], f)
         if f < best_f:
