@@ -42,6 +42,7 @@ import math
 import time
 
 import numpy as np
+import scipy.linalg
 
 from . import _cohort_kernels as CK
 from .cycle import CycleFixedPoint, _initial_marginal, _rows
@@ -82,6 +83,19 @@ ANDERSON_STALL = 8
 #: Anderson's map drops the blocks a shock leaves unjumped: it is used only where they are
 #: at most this fraction (the plain cycles that verify its result restore them).
 ANDERSON_UNJUMPED = 1e-3
+#: Anderson's iteration stops when its step (the preconditioned residual, about the
+#: distance to the fixed point, in mass) is below this times ``tol``: sigma moved by about
+#: 0.15 of the step there (k0 = 1e-4, 0.95 V^c), so the plain cycles after it find their
+#: steps below tol / 100.
+ANDERSON_TOL = 0.05
+#: The band preconditioner of Anderson's map (:func:`_band_preconditioner`): BAND_COLOURS
+#: cycles at frozen slips, each from every BAND_COLOURS-th node, and a node's image taken
+#: from BAND_COLOURS - BAND_ABOVE nodes below it to BAND_ABOVE - 1 above (a block's
+#: delta_R moves by a few nodes in a cycle, with an exponential tail downwards).
+BAND_COLOURS = 16
+BAND_ABOVE = 6
+#: The forward-difference step of the full map's response to a shift of the marginal.
+SHIFT_FD = 1e-4
 #: A converged run that extrapolated (Aitken) a sequence contracting by more than this a
 #: cycle, or one after Anderson's acceleration, says in its message that its error estimate
 #: can miss a slower mode (measured: benchmarks/micro_cohort_estimate_check.py).  (Where
@@ -394,8 +408,74 @@ def _product_cycle(model: Model, V: float, h: float, step: float, ref: float,
     return st, out, g / g.sum()
 
 
+def _frozen_cycle(model: Model, V: float, h: float, sigma: float, steps, x: np.ndarray) -> np.ndarray:
+    """The cycle at frozen slips: the product state of Exp margins and node masses ``x``
+    (not normalised) at stress ``sigma``, taken through a cycle's ``steps`` (its
+    ``(length, slip)`` pairs, the shock's last) with their slips imposed instead of
+    solved for.  Returns the node masses of the blocks the shock made jump.
+
+    With the slips given, where each member crosses does not depend on the density, so
+    this is linear in ``x`` (up to the floors' kink rule, which keeps each cell's surviving
+    mass: :func:`_band_jacobian`); from the cycle's own start it repeats the cycle."""
+    st = _Cohorts(model, V, h)
+    st.sigma = sigma
+    st.add(x)
+    for length, slip in steps:
+        phi, Edt = st.prepare(length)
+        st.commit(slip, length, phi, Edt)
+    return st.dense(st.n - 1)
+
+
+def _band_preconditioner(model: Model, V: float, h: float, step: float, ref: float, x: np.ndarray, out: dict,
+                         g: np.ndarray):
+    """``M``, approximately ``(I - J)^-1`` for the cycle map's Jacobian ``J`` at ``x``
+    (its cycle ``out``, its image ``g``), and the slowest multipliers of the frozen map.
+
+    The cycle map is slow because of the single blocks: between shocks each block's
+    delta_R relaxes alone, by about ``1 - alpha (1 - exp(-gamma T))`` a cycle, so the
+    marginal's moments relax like its powers (the multipliers 0.98, 0.97, ... close to
+    V^c, a continuum of them).  With the cycle's slips frozen the map is linear in the
+    marginal and moves each node's mass by a few nodes: ``L``, banded, found from
+    BAND_COLOURS cycles at frozen slips (:func:`_frozen_cycle`), each from every
+    BAND_COLOURS-th node at once.  What the frozen map lacks is the slips' response to the
+    marginal, of low rank: the normalisation (the map's mass is 1) and the marginal's mean
+    (a shift of the lags moves the stress, and the next shock, with it; in the frozen map
+    it relaxes like a block, in the full map it does not) are taken out of ``L``, and
+    Anderson's mixing deals with the rest."""
+    S = np.flatnonzero((x > 0.0) | (g > 0.0))
+    S = np.arange(max(S[0] - 2, 0), min(S[-1] + 3, x.size))
+    n = S.size
+    L = np.zeros((n, n))
+    for c in range(min(BAND_COLOURS, n)):
+        cols = np.arange(c, n, BAND_COLOURS)
+        e = np.zeros(x.size)
+        e[S[cols]] = 1.0
+        image = _frozen_cycle(model, V, h, out["start"], out["steps"], e)[S]
+        for j in cols:
+            lo, hi = max(j - BAND_COLOURS + BAND_ABOVE, 0), min(j + BAND_ABOVE, n)
+            L[lo:hi, j] = image[lo:hi]
+    gS = g[S] / g[S].sum()
+    L -= np.outer(gS, L.sum(axis=0))
+    # the marginal moved up by one node: the full map's response, by a forward difference
+    y = S * h  # (node positions up to an offset, which acts on the mass alone: zero in a residual)
+    shift = np.zeros(x.size)
+    shift[1:] = x[:-1] - x[1:]
+    shift[0] = -x[0]
+    _, _, g_shift = _product_cycle(model, V, h, step, ref, x + SHIFT_FD * shift)
+    v, Jv = shift[S], (g_shift[S] - gS) / SHIFT_FD
+    L += np.outer(Jv - L @ v, y) / (y @ v)
+    lu = scipy.linalg.lu_factor(np.eye(n) - L)
+    slowest = np.sort(np.abs(np.linalg.eigvals(L)))[::-1][:3]
+
+    def M(r: np.ndarray) -> np.ndarray:
+        out = r.copy()
+        out[S] = scipy.linalg.lu_solve(lu, r[S])
+        return out
+    return M, slowest
+
+
 def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.ndarray, ref: float,
-              tol: float, max_evals: int) -> tuple[_Cohorts | None, int]:
+              tol: float, max_evals: int) -> tuple[_Cohorts | None, int, float]:
     """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
     total shock (a product state), for the sequences that contract slowly (close to V^c).
 
@@ -414,31 +494,38 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.
     xs: list[np.ndarray] = []
     gs: list[np.ndarray] = []
     x, best, best_f = dep / dep.sum(), None, math.inf
-    since = 0
+    since, M, slow = 0, None, math.nan
     for k in range(1, max_evals + 1):
         st, out, g = _product_cycle(model, V, h, step, ref, x)
         if g is None or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
-            return best, k
-        f = float(np.abs(g - x).sum())
-        log.debug("anderson %d: sigma_max %.10f, the cycle moves %.2e of the mass", k, out["sigma_max"], f)
+            return best, k, slow
+        if M is None:
+            M, slowest = _band_preconditioner(model, V, h, step, ref, x, out, g)
+            slow = float(slowest[0])
+            log.debug("anderson: frozen map's slowest multipliers %s", slowest)
+        step_x = M(g - x)  # about the distance to the fixed point
+        f = float(np.abs(step_x).sum())
+        log.debug("anderson %d: sigma_max %.10f, the cycle moves %.2e of the mass, the step %.2e", k,
+                  out["sigma_max"], float(np.abs(g - x).sum()), f)
         if f < best_f:
             best, best_f, since = st, f, 0
         else:
             since += 1
         if best_f <= tol or since >= ANDERSON_STALL:
-            return best, k
+            return best, k, slow
         xs.append(x)
-        gs.append(g)
+        gs.append(x + step_x)
         del xs[:-ANDERSON_WINDOW - 1], gs[:-ANDERSON_WINDOW - 1]
         if len(xs) < 2:
-            x = g
+            x = np.maximum(gs[-1], 0.0)
+            x /= x.sum()
             continue
         F = np.array([b - a for a, b in zip(xs, gs)])
         dF, dG = np.diff(F, axis=0).T, np.diff(np.array(gs), axis=0).T
         gamma = np.linalg.lstsq(dF, F[-1], rcond=None)[0]
-        x = np.maximum(g - dG @ gamma, 0.0)
+        x = np.maximum(gs[-1] - dG @ gamma, 0.0)
         x /= x.sum()
-    return best, max_evals
+    return best, max_evals, slow
 
 
 def _peak_before(st: _Cohorts, t_start: float, dt: float) -> float:
@@ -486,6 +573,7 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     t_start, sigma_start, integral = st.t, st.sigma, 0.0
     peak = trough = st.sigma
     snapshot = None
+    steps = []  # (length, slip) of every step the cycle committed, the shock's last
     replay = st.peak_excess > PEAK_FLOOR
     t_max = 20.0 * st.lam / (st.model.k0 * st.V)
     gamma = st.model.gamma
@@ -494,6 +582,7 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
         nonlocal integral, peak, trough
         s0 = st.sigma
         st.commit(x, length, phi, Edt)
+        steps.append((length, x))
         integral += 0.5 * (s0 + st.sigma) * length
         peak, trough = max(peak, st.sigma), min(trough, st.sigma)
 
@@ -541,12 +630,13 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     except RuntimeError as err:
         return dict(ok=False, message=str(err))
     st.commit(slip, 0.0, 0.0, 1.0)
+    steps.append((0.0, slip))
     cell = st.cell_masses()
     unjumped = float(st.surviving(cell)[:n_old].sum())
     st.compact(cell)
     return dict(ok=True, sigma_max=peak, sigma_min=trough, period=period,
                 sigma_mean=integral / period if period > 0 else sigma_before, sigma_before=sigma_before,
-                sigma_after=st.sigma, unjumped=unjumped, start=sigma_start)
+                sigma_after=st.sigma, unjumped=unjumped, start=sigma_start, steps=steps)
 
 
 #: The columns of a cycle's row in the history, and those whose error decides convergence.
@@ -642,6 +732,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     if int(max_iter) != max_iter or max_iter < 4:
         raise ValueError(f"max_iter must be an integer >= 4, got {max_iter!r}")
     given = start if start is not None and start is not _NO_COARSE else None
+    coarse = None
     st = _continued(given, model, V, h)
     step = dt
     if st is None and start is not _NO_COARSE and (given is None or given.p is None) \
@@ -659,11 +750,15 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 given = coarse
     if st is None:
         st = _start(model, V, h, given.p if given is not None else None)
+    # a start whose run was accelerated (the coarse transient, or a nearby V) is close to
+    # V^c: this run is accelerated at its first cycle, not after WINDOW plain ones
+    eager = bool(getattr(given if given is not None else coarse, "accelerated", False))
     hist: list[tuple[float, ...]] = []
     error, converged, applicable, message = math.nan, False, True, ""
     value = np.full(len(COLUMNS), math.nan)
     out: dict = {}
     it, accelerated, passed = 0, False, 0
+    slow_multiplier = math.nan
     while it < max_iter:
         it += 1
         out = _one_cycle(st, step)
@@ -690,18 +785,27 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         hist.append(tuple(out[name] for name in COLUMNS))
         log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f", it, out["sigma_max"],
                   out["sigma_min"], out["sigma_before"])
-        if len(hist) < WINDOW:
+        if len(hist) < WINDOW and not (eager and not accelerated):
             continue
-        errors, how, best, rho = _estimate(np.array(hist), tol)
-        error = float(errors[list(JUDGED)].max())
-        slow = any(errors[i] > tol and how[i] in ("Aitken", "slow") and rho[i] > 0.9 for i in JUDGED)
-        if not accelerated and error > tol and slow and out["unjumped"] <= ANDERSON_UNJUMPED:
+        if len(hist) >= WINDOW:
+            errors, how, best, rho = _estimate(np.array(hist), tol)
+            if accelerated and 0.0 < slow_multiplier < 1.0:
+                # after the acceleration the sequence holds what the map's slowest modes
+                # left: a last step d leaves up to d m / (1 - m) to go (m the slowest
+                # multiplier, of the map at frozen slips)
+                last = np.abs(np.diff(np.array(hist)[-2:], axis=0)[0])
+                errors = np.maximum(errors, last * slow_multiplier / (1.0 - slow_multiplier))
+            error = float(errors[list(JUDGED)].max())
+            slow = any(how[i] in ("Aitken", "slow") and rho[i] > SLOW_CAVEAT for i in JUDGED)
+        else:
+            slow = True  # (the start's own run was accelerated: so is this one, at once)
+        if not accelerated and slow and out["unjumped"] <= ANDERSON_UNJUMPED:
             # a product state contracting slowly (close to V^c): accelerate it,
             # then verify the result by the plain cycles again (with at least half the
             # cycles left: below the map's roughness, about 1e-6 of the mass at tol = 1e-6,
             # Anderson's residual creeps down without stalling and used to take them all)
             accelerated = True
-            fast, used = _anderson(model, V, h, step, dt, st.dense(st.n - 1), st.period_ref, tol,
+            fast, used, slow_multiplier = _anderson(model, V, h, step, dt, st.dense(st.n - 1), st.period_ref, ANDERSON_TOL * tol,
                                     max((int(max_iter) - it) // 2, 1))
             it += used
             if fast is not None:
@@ -709,6 +813,8 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 hist.clear()
                 passed = 0
                 continue
+        if len(hist) < WINDOW:
+            continue
         passed = passed + 1 if error <= tol else 0
         if passed >= 2:  # (two cycles in a row: one estimate may pass by chance)
             converged, value = True, best
@@ -718,11 +824,12 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                        f"{COLUMNS[worst]}, to {errors[worst]:.1e}")
             extrapolated = [rho[i] for i in JUDGED if how[i] == "Aitken"]
             ratio = max(extrapolated, default=0.0)
-            if extrapolated and (accelerated or ratio > SLOW_CAVEAT):
-                message += ("; " + ("after Anderson's acceleration" if accelerated else
-                                    f"the cycles contract by {ratio:.2f} a cycle") +
-                            ", five cycles can hide a slower mode: close to V^c the estimate was measured up to "
-                            "80 times too small (docs/reference/micro_cohort.md, section 4)")
+            if accelerated and 0.0 < slow_multiplier < 1.0:
+                message += (f"; after Anderson's preconditioned iteration, each error at least the last step "
+                            f"times m / (1 - m), m = {slow_multiplier:.4f} the map's slowest multiplier")
+            elif extrapolated and ratio > SLOW_CAVEAT:
+                message += (f"; the cycles contract by {ratio:.2f} a cycle, five cycles can hide a slower mode "
+                            "(docs/reference/micro_cohort.md, section 4)")
             break
     if not converged and not message:
         message = f"no fixed point to {tol:g} in {max_iter} cycles (error estimate {error:.2g})"
@@ -735,6 +842,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         unjumped=out.get("unjumped", math.nan), converged=converged, message=message,
         wall_time=time.perf_counter() - begin, applicable=applicable, history=values,
         sigma_before=float(value[4]), sigma_after=float(value[5]))
+    res.accelerated = accelerated
     if applicable and len(hist):
         st.dt = step
         res.state = st
