@@ -799,7 +799,10 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             slow = any(how[i] in ("Aitken", "slow") and rho[i] > SLOW_CAVEAT for i in JUDGED)
         else:
             slow = True  # (the start's own run was accelerated: so is this one, at once)
-        if not accelerated and slow and out["unjumped"] <= ANDERSON_UNJUMPED:
+        # (only a short loading phase makes the blocks' relaxation slow from cycle to
+        # cycle: the slowest multiplier is about exp(-0.19 T); from 0.7 V^c down a ratio
+        # above 0.9 is noise, and the acceleration there cost more than it saved)
+        if not accelerated and slow and out["period"] < SHORT_PHASE and out["unjumped"] <= ANDERSON_UNJUMPED:
             # a product state contracting slowly (close to V^c): accelerate it,
             # then verify the result by the plain cycles again (with at least half the
             # cycles left: below the map's roughness, about 1e-6 of the mass at tol = 1e-6,
