@@ -408,6 +408,30 @@ def _product_cycle(model: Model, V: float, h: float, step: float, ref: float,
     return st, out, g / g.sum()
 
 
+def _carried_cycle(base: _Cohorts, step: float, ref: float, x: np.ndarray) -> tuple[_Cohorts, dict, np.ndarray | None]:
+    """The cycle map on the delta_R marginal after a shock, with the blocks the shock left
+    unjumped carried along: one cycle (steps of ``step``, graded to ``ref``) from a copy of
+    the state ``base`` just after a shock, its newborns' marginal replaced by ``x`` (scaled
+    to their mass; the stress moved by the change of their mean delta_R, so that the mean
+    lag stays zero: docs/reference/micro_cohort.md section 2).  Returns the state after it,
+    the cycle's row and the normalised marginal of the blocks its shock made jump (None if
+    the cycle failed).  Where shocks are total this is :func:`_product_cycle`."""
+    st = base.copy()
+    c = st.n - 1
+    old = st.dense(c)
+    new = x * (old.sum() / x.sum())
+    st.pool -= st.nn[c]
+    st.n -= 1
+    st.sigma += float((new - old) @ (st.ylo + np.arange(st.ny) * st.h))
+    st.add(new)
+    st.period_ref = ref
+    out = _one_cycle(st, step)
+    if not out["ok"]:
+        return st, out, None
+    g = st.dense(st.n - 1)
+    return st, out, g / g.sum()
+
+
 def _frozen_cycle(model: Model, V: float, h: float, sigma: float, steps, x: np.ndarray) -> np.ndarray:
     """The cycle at frozen slips: the product state of Exp margins and node masses ``x``
     (not normalised) at stress ``sigma``, taken through a cycle's ``steps`` (its
@@ -426,10 +450,10 @@ def _frozen_cycle(model: Model, V: float, h: float, sigma: float, steps, x: np.n
     return st.dense(st.n - 1)
 
 
-def _band_preconditioner(model: Model, V: float, h: float, step: float, ref: float, x: np.ndarray, out: dict,
-                         g: np.ndarray):
-    """``M``, approximately ``(I - J)^-1`` for the cycle map's Jacobian ``J`` at ``x``
-    (its cycle ``out``, its image ``g``), and the slowest multipliers of the frozen map.
+def _band_preconditioner(model: Model, V: float, h: float, G, x: np.ndarray, out: dict, g: np.ndarray):
+    """``M``, approximately ``(I - J)^-1`` for the Jacobian ``J`` of the cycle map ``G``
+    (x -> (state, row, image)) at ``x`` (its cycle ``out``, its image ``g``), and the
+    slowest multipliers of the frozen map.
 
     The cycle map is slow because of the single blocks: between shocks each block's
     delta_R relaxes alone, by about ``1 - alpha (1 - exp(-gamma T))`` a cycle, so the
@@ -461,7 +485,7 @@ def _band_preconditioner(model: Model, V: float, h: float, step: float, ref: flo
     shift = np.zeros(x.size)
     shift[1:] = x[:-1] - x[1:]
     shift[0] = -x[0]
-    _, _, g_shift = _product_cycle(model, V, h, step, ref, x + SHIFT_FD * shift)
+    _, _, g_shift = G(x + SHIFT_FD * shift)
     v, Jv = shift[S], (g_shift[S] - gS) / SHIFT_FD
     L += np.outer(Jv - L @ v, y) / (y @ v)
     lu = scipy.linalg.lu_factor(np.eye(n) - L)
@@ -474,39 +498,41 @@ def _band_preconditioner(model: Model, V: float, h: float, step: float, ref: flo
     return M, slowest
 
 
-def _anderson(model: Model, V: float, h: float, step: float, dt: float, dep: np.ndarray, ref: float,
+def _anderson(model: Model, V: float, h: float, step: float, dt: float, base: _Cohorts, ref: float,
               tol: float, max_evals: int) -> tuple[_Cohorts | None, int, float]:
-    """Anderson's acceleration of the cycle map on the delta_R marginal ``dep`` after a
-    total shock (a product state), for the sequences that contract slowly (close to V^c).
+    """Anderson's acceleration of the cycle map on the delta_R marginal after a shock
+    (:func:`_carried_cycle`, from the state ``base`` just after one), for the sequences
+    that contract slowly (close to V^c), preconditioned by the map at frozen slips
+    (:func:`_band_preconditioner`).
 
-    One evaluation is one cycle from a product state (its steps graded to the loading
-    phase ``ref``); the blocks its shock leaves unjumped
-    (at most ANDERSON_UNJUMPED of the mass) are dropped.  Type-II Anderson
-    mixing with a window of ANDERSON_WINDOW, stopped when a cycle moves less than ``tol``
-    of the mass, or when ANDERSON_STALL evaluations did not improve on the best one.
-    (Stopping sooner, when 8 evaluations did not halve the residual, left the plain
-    cycles a mixture of modes that Aitken's extrapolation misjudged: at k0 = 1e-3,
-    0.95 V^c, continued from 0.9 V^c, sigma_max 1e-4 off with 4e-6 claimed.)
-    Returns the state after the best evaluation's cycle (its newborn marginal the best
-    image, with the blocks that cycle's shock left: a state of the full dynamics), or None
-    if the map does not apply, and the evaluations used.
+    One evaluation is one cycle (its steps graded to the loading phase ``ref``), the blocks
+    the last shock left unjumped (at most ANDERSON_UNJUMPED of the mass) carried from the
+    evaluation before.  Type-II Anderson mixing of the preconditioned map
+    x + M (G(x) - x) with a window of ANDERSON_WINDOW, stopped when its step (about the
+    distance to the fixed point) is below ``tol`` of the mass, or when ANDERSON_STALL
+    evaluations did not improve on the best one.  Returns the state after the best
+    evaluation's cycle (a state of the full dynamics), or None if the map does not apply,
+    the evaluations used, and the frozen map's slowest multiplier.
     """
     xs: list[np.ndarray] = []
     gs: list[np.ndarray] = []
+    dep = base.dense(base.n - 1)
     x, best, best_f = dep / dep.sum(), None, math.inf
     since, M, slow = 0, None, math.nan
     for k in range(1, max_evals + 1):
-        st, out, g = _product_cycle(model, V, h, step, ref, x)
+        st, out, g = _carried_cycle(base, step, ref, x)
         if g is None or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
             return best, k, slow
         if M is None:
-            M, slowest = _band_preconditioner(model, V, h, step, ref, x, out, g)
+            M, slowest = _band_preconditioner(model, V, h, lambda v, b=base: _carried_cycle(b, step, ref, v),
+                                              x, out, g)
             slow = float(slowest[0])
             log.debug("anderson: frozen map's slowest multipliers %s", slowest)
         step_x = M(g - x)  # about the distance to the fixed point
         f = float(np.abs(step_x).sum())
         log.debug("anderson %d: sigma_max %.10f, the cycle moves %.2e of the mass, the step %.2e", k,
                   out["sigma_max"], float(np.abs(g - x).sum()), f)
+        base = st  # (the next evaluation carries the blocks this shock left)
         if f < best_f:
             best, best_f, since = st, f, 0
         else:
@@ -624,7 +650,6 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
         st.period_ref = period
     st.prepare(0.0)
     x, _ = st.root()
-    n_old = st.n
     try:
         slip = st.shock_root(max(x, 1e-12 * st.model.zbar))
     except RuntimeError as err:
@@ -632,7 +657,9 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     st.commit(slip, 0.0, 0.0, 1.0)
     steps.append((0.0, slip))
     cell = st.cell_masses()
-    unjumped = float(st.surviving(cell)[:n_old].sum())
+    # (the shock's newborns are the last cohort; not counted by index from before the
+    # shock, since storing them may have compacted the cohorts)
+    unjumped = float(st.surviving(cell)[:-1].sum())
     st.compact(cell)
     return dict(ok=True, sigma_max=peak, sigma_min=trough, period=period,
                 sigma_mean=integral / period if period > 0 else sigma_before, sigma_before=sigma_before,
@@ -808,7 +835,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             # cycles left: below the map's roughness, about 1e-6 of the mass at tol = 1e-6,
             # Anderson's residual creeps down without stalling and used to take them all)
             accelerated = True
-            fast, used, slow_multiplier = _anderson(model, V, h, step, dt, st.dense(st.n - 1), st.period_ref, ANDERSON_TOL * tol,
+            fast, used, slow_multiplier = _anderson(model, V, h, step, dt, st, st.period_ref, ANDERSON_TOL * tol,
                                     max((int(max_iter) - it) // 2, 1))
             it += used
             if fast is not None:

@@ -281,7 +281,7 @@ def test_anderson_beats_the_plain_cycles_close_to_vc():
         g = s.dense(s.n - 1)
         return np.abs(g / g.sum() - x / x.sum()).sum()
 
-    state, used, _ = _anderson(model, V, h, dt, 0.01, x0, st.period_ref, 1e-12, 15)
+    state, used, _ = _anderson(model, V, h, dt, 0.01, st.copy(), st.period_ref, 1e-12, 15)
     assert state is not None and used == 15
     fast = state.dense(state.n - 1)
     st = _start(model, V, h, None, dep=x0)
@@ -349,8 +349,9 @@ def test_the_slow_modes_are_the_single_blocks_relaxing():
     response to a shift of the marginal, which moves the stress).  Newton's check with the whole Jacobian gives 0.9830
     here (benchmarks/results/micro_cohort_newton_check.csv)."""
     from micro.cohort import _band_preconditioner
+    from micro.cohort import _product_cycle
     model, V, h, x, out, g, step, ref = _near_vc_product_cycle()
-    _, slowest = _band_preconditioner(model, V, h, step, ref, x, out, g)
+    _, slowest = _band_preconditioner(model, V, h, lambda v: _product_cycle(model, V, h, step, ref, v), x, out, g)
     alpha = (model.k0 + model.k1) / model.kappa
     a = 1.0 - alpha * (1.0 - math.exp(-model.gamma * out["period"]))
     assert slowest[0] == pytest.approx(a * a, abs=5e-3)  # (0.9825 against 0.9858: blocks also jump between shocks)
@@ -371,3 +372,24 @@ def test_close_to_vc_the_run_finds_newtons_fixed_point():
     err_max, err_min = abs(res.sigma_max - 0.9071486001455795), abs(res.sigma_min - 0.899914921575336)
     assert max(err_max, err_min) < 1e-6
     assert max(err_max, err_min) < 3.0 * res.error + 1e-8, (err_max, err_min, res.error)
+
+
+def test_the_carried_cycle_from_a_state_is_its_own_cycle():
+    """The map Anderson's iteration runs on: the state just after a shock with its newborns'
+    marginal put back as it was is the same state, so its cycle is the plain one, and so is
+    the count of blocks its shock left unjumped (it used to count the newborns too when
+    storing them compacted the copy's cohorts: 0.99999 instead of 3e-34)."""
+    from micro.cohort import _carried_cycle
+    model = micro.Model(k0=0.001)
+    V = 0.95 * micro.critical_velocity(model).Vc
+    h, step = model.kappa * model.zbar / 10, 0.0032616871833801
+    st = _start(model, V, h, None)
+    for _ in range(3):
+        _one_cycle(st, step)
+    plain = st.copy()
+    row = _one_cycle(plain, step)
+    state, carried, g = _carried_cycle(st, step, st.period_ref, st.dense(st.n - 1))
+    assert carried["unjumped"] == pytest.approx(row["unjumped"], abs=1e-12) and row["unjumped"] < 1e-9
+    for name in ("sigma_max", "sigma_min", "period"):
+        assert carried[name] == pytest.approx(row[name], abs=1e-9)
+    assert np.abs(g - plain.dense(plain.n - 1) / plain.dense(plain.n - 1).sum()).sum() < 1e-7
