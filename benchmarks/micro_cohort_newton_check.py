@@ -1,16 +1,18 @@
 """The cohort method's fixed point close to V^c, checked by Newton's method on the cycle map.
 
-Close to V^c the cycle-to-cycle sequence contracts slowly (by up to 0.98 a cycle) and
-``micro.cohort.cycle_cohorts`` rests on Aitken's extrapolation of five cycles (after
-Anderson's acceleration), which can miss a slower mode.  This script solves the same
-fixed point by a method that does not: Newton's method with the whole Jacobian.
+Close to V^c the cycle-to-cycle sequence contracts slowly (by up to 0.98 a cycle);
+``micro.cohort.cycle_cohorts`` solves the fixed point by Anderson's iteration
+preconditioned by the map at frozen slips (a band), and bounds the error by its last
+plain cycles.  This script solves the same fixed point by Newton's method with the
+whole Jacobian, by forward differences (it was written when the method rested on
+Aitken's extrapolation of five cycles, which missed a slower mode).
 
 For each point (Fig. 4 parameters, k0 and V / V^c, total shocks: k0 <= 0.01) the cohort
 method is run at ``--dt``, ``--h`` to ``--tol``.  Its last cycle fixes the map: one
 cycle, at the run's own step and graded-grid reference, from a product state (Exp
 margins times a delta_R marginal x) to the delta_R marginal of the blocks the shock
-leaves (the blocks it leaves unjumped, ``unjumped`` of the mass, dropped; as in the
-method's Anderson acceleration).  Its Jacobian on the marginal's support is taken by
+leaves (the blocks it leaves unjumped, ``unjumped`` of the mass, dropped; the method's
+own map carries them to the next cycle).  Its Jacobian on the marginal's support is taken by
 forward differences (one cycle per node, step ``--fd``), its eigenvalues are the cycle's
 Floquet multipliers, and Newton's iteration x <- x + (I - J)^-1 (G(x) - x) (the Jacobian
 of the start, a chord method) is run until the cycle moves less than 1e-10 of the mass.

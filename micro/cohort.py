@@ -80,14 +80,18 @@ GRADED_SLACK = 0.25
 #: after which it stops.
 ANDERSON_WINDOW = 10
 ANDERSON_STALL = 8
-#: Anderson's map drops the blocks a shock leaves unjumped: it is used only where they are
-#: at most this fraction (the plain cycles that verify its result restore them).
+#: Anderson's map is on the marginal of the blocks a shock made jump (the others carried
+#: from one evaluation to the next): it is used only where those others are at most this
+#: fraction.
 ANDERSON_UNJUMPED = 1e-3
 #: Anderson's iteration stops when its step (the preconditioned residual, about the
 #: distance to the fixed point, in mass) is below this times ``tol``: sigma moved by about
 #: 0.15 of the step there (k0 = 1e-4, 0.95 V^c), so the plain cycles after it find their
 #: steps below tol / 100.
 ANDERSON_TOL = 0.05
+#: Halvings of a step whose cycle the map does not apply to (a changed time step, too
+#: many blocks unjumped) before Anderson's iteration gives up.
+ANDERSON_BACKTRACKS = 3
 #: The band preconditioner of Anderson's map (:func:`_band_preconditioner`): BAND_COLOURS
 #: cycles at frozen slips, each from every BAND_COLOURS-th node, and a node's image taken
 #: from BAND_COLOURS - BAND_ABOVE nodes below it to BAND_ABOVE - 1 above (a block's
@@ -96,10 +100,12 @@ BAND_COLOURS = 16
 BAND_ABOVE = 6
 #: The forward-difference step of the full map's response to a shift of the marginal.
 SHIFT_FD = 1e-4
-#: A converged run that extrapolated (Aitken) a sequence contracting by more than this a
-#: cycle, or one after Anderson's acceleration, says in its message that its error estimate
-#: can miss a slower mode (measured: benchmarks/micro_cohort_estimate_check.py).  (Where
-#: the last steps are below tol / 100, a mode contracting by up to 0.99 stays within tol.)
+#: A run whose five-cycle window contracts by more than this a cycle is accelerated (where
+#: the loading phase is shorter than SHORT_PHASE and shocks all but total); one that
+#: extrapolated (Aitken) such a sequence without the acceleration says in its message that
+#: its error estimate can miss a slower mode (measured:
+#: benchmarks/micro_cohort_estimate_check.py).  (Where the last steps are below tol / 100,
+#: a mode contracting by up to 0.99 stays within tol.)
 SLOW_CAVEAT = 0.9
 #: A step's Newton iteration for its slip starts at this fraction of the slip rate
 #: extrapolated from the two steps before, times its length (:meth:`_Cohorts.root`).
@@ -462,10 +468,11 @@ def _band_preconditioner(model: Model, V: float, h: float, G, x: np.ndarray, out
     marginal and moves each node's mass by a few nodes: ``L``, banded, found from
     BAND_COLOURS cycles at frozen slips (:func:`_frozen_cycle`), each from every
     BAND_COLOURS-th node at once.  What the frozen map lacks is the slips' response to the
-    marginal, of low rank: the normalisation (the map's mass is 1) and the marginal's mean
-    (a shift of the lags moves the stress, and the next shock, with it; in the frozen map
-    it relaxes like a block, in the full map it does not) are taken out of ``L``, and
-    Anderson's mixing deals with the rest."""
+    marginal, of low rank: the normalisation (the map's mass is 1) is taken out of ``L``,
+    and the full map's response to a shift of the marginal by one node (in the frozen map
+    the mean relaxes like a block; in the full map the stress follows it) is measured by
+    one more cycle and put in; Anderson's mixing deals with the rest
+    (docs/reference/micro_cohort.md, section 4)."""
     S = np.flatnonzero((x > 0.0) | (g > 0.0))
     S = np.arange(max(S[0] - 2, 0), min(S[-1] + 3, x.size))
     n = S.size
@@ -519,10 +526,18 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, base: _C
     dep = base.dense(base.n - 1)
     x, best, best_f = dep / dep.sum(), None, math.inf
     since, M, slow = 0, None, math.nan
+    backtracks = 0
     for k in range(1, max_evals + 1):
         st, out, g = _carried_cycle(base, step, ref, x)
         if g is None or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
-            return best, k, slow
+            if not xs or backtracks >= ANDERSON_BACKTRACKS:
+                return best, k, slow
+            # far from the fixed point (a sweep's first cycles) a step can overshoot into
+            # a state the map does not apply to: halve it towards the last evaluated one
+            backtracks += 1
+            x = 0.5 * (x + xs[-1])
+            continue
+        backtracks = 0
         if M is None:
             M, slowest = _band_preconditioner(model, V, h, lambda v, b=base: _carried_cycle(b, step, ref, v),
                                               x, out, g)
@@ -735,13 +750,14 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     sigma_after gets its error from the last WINDOW cycles (:func:`_estimate`: Aitken's
     extrapolation where the contraction ratios are steady), and the iteration stops when
     all are within ``tol`` in two cycles in a row.  Close to V^c, where
-    the ratio nears 1 and the shocks are all but total, the marginal after a shock is
-    accelerated by Anderson's method (:func:`_anderson`) and the result verified by plain
-    cycles again.  ``error`` is the error of the fixed point at this ``dt`` and ``h``,
-    not their discretisation error (``h`` defaults to ``kappa zbar / 20``); close to V^c
-    it can miss a slower mode (at 0.95 V^c it was measured up to 80 times too small,
-    against Newton's method on the cycle map: the true distance 3.2e-5), and the message
-    then says so.  ``dt``
+    the ratio nears 1 and the shocks are all but total, the fixed point of the map on the
+    marginal after a shock is solved by Anderson's method preconditioned by the cycle at
+    frozen slips (:func:`_anderson`), the result verified by plain cycles again, and each
+    error is then at least the last step times m / (1 - m), m the map's slowest
+    multiplier.  ``error`` is the error of the fixed point at this ``dt`` and ``h``, not
+    their discretisation error (``h`` defaults to ``kappa zbar / 20``).  Close to V^c
+    without the acceleration (shocks that leave many blocks, k0 = 0.1, 0.3) five cycles
+    can hide a slower mode, and the message then says so.  ``dt``
     is the step of loading phases longer than SHORT_PHASE, within ``1 / gamma`` of their
     ends (up to four times longer between: :func:`_step_length`); shorter ones (close to
     V^c) get steps ``dt * T / SHORT_PHASE`` (a fiftieth of T at the default dt).

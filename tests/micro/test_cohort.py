@@ -393,3 +393,44 @@ def test_the_carried_cycle_from_a_state_is_its_own_cycle():
     for name in ("sigma_max", "sigma_min", "period"):
         assert carried[name] == pytest.approx(row[name], abs=1e-9)
     assert np.abs(g - plain.dense(plain.n - 1) / plain.dense(plain.n - 1).sum()).sum() < 1e-7
+
+
+def test_anderson_halves_a_step_the_map_does_not_apply_to(monkeypatch):
+    """A step far from the fixed point can land on a state whose cycle the map does not
+    apply to (here: the second evaluation's cycle reports too many blocks unjumped); the
+    iteration halves it towards the last evaluated marginal and goes on, instead of
+    ending there (as it did at k0 = 1e-3, 0.9 V^c in a sweep: 200 plain cycles after it,
+    not converged)."""
+    from micro import cohort
+    model, V, h, x, out, g, step, ref = _near_vc_product_cycle()
+    st = _start(model, V, h, None, dep=x)
+    st.period_ref = ref
+    real, tried = cohort._carried_cycle, []
+
+    def flaky(base, step_, ref_, v):
+        tried.append(v.copy())
+        state, row, image = real(base, step_, ref_, v)
+        if len(tried) == 3:  # (the second call is the preconditioner's shift)
+            row = dict(row, unjumped=0.5)
+        return state, row, image
+    monkeypatch.setattr(cohort, "_carried_cycle", flaky)
+    best, used, slow = cohort._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 6)
+    assert best is not None and used == 6 and 0.97 < slow < 1.0
+    # the next evaluation is the midpoint of the first and the refused second
+    assert np.abs(tried[3] - 0.5 * (tried[0] / tried[0].sum() + tried[2])).sum() < 1e-12
+
+
+@pytest.mark.slow
+def test_a_sweep_reaches_the_fixed_point_close_to_vc():
+    """The Fig. 10 sweep at k0 = 1e-3: 0.5, 0.7, then 0.9 V^c, each row from the one
+    before.  The first preconditioned step from the 0.7 V^c state overshot into a cycle
+    with a cut time step; the iteration then ended, and 200 plain cycles did not converge
+    (here 60; with the step halved: 24 cycles)."""
+    model = micro.Model(k0=0.001)
+    Vc = micro.critical_velocity(model).Vc
+    prev = None
+    for f in (0.5, 0.7):
+        prev = cycle_cohorts(model, f * Vc, tol=1e-5, start=prev)
+    res = cycle_cohorts(model, 0.9 * Vc, tol=1e-5, start=prev, max_iter=60)
+    assert res.converged and res.error < 1e-6, res.message
+    assert res.sigma_max == pytest.approx(0.9138178, abs=1e-6)
