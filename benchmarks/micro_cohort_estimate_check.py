@@ -11,7 +11,7 @@ sigma_min from it is the true error that the claimed ``error`` estimates.
 Writes benchmarks/results/micro_cohort_estimate_check.csv (rows merge by k0, V / V^c,
 dt, h and tol).
 
-    python benchmarks/micro_cohort_estimate_check.py          # about 12 minutes on 2 cores
+    python benchmarks/micro_cohort_estimate_check.py          # about 7 minutes on 2 cores
 """
 from __future__ import annotations
 

@@ -9,7 +9,7 @@ true distance to the fixed point.  Compilation is done first and not counted.
 Writes benchmarks/results/micro_cohort_speed.csv (rows merge by k0, V / V^c, tol, so an
 interrupted run keeps its rows).
 
-    python benchmarks/micro_cohort_speed.py                 # about 5 minutes on 2 cores
+    python benchmarks/micro_cohort_speed.py                 # about 3 minutes on 2 cores
     python benchmarks/micro_cohort_speed.py --reference     # and the references: ~30 minutes
 """
 from __future__ import annotations

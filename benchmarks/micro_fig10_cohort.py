@@ -11,7 +11,7 @@ branch.
 
 Writes benchmarks/results/micro_fig10_cohort.csv and micro_fig10_cohort.png.
 
-    python benchmarks/micro_fig10_cohort.py        # about 10 minutes on 2 cores
+    python benchmarks/micro_fig10_cohort.py        # about 5 minutes on 2 cores
 """
 from __future__ import annotations
 
