@@ -414,7 +414,8 @@ def _product_cycle(model: Model, V: float, h: float, step: float, ref: float,
     return st, out, g / g.sum()
 
 
-def _carried_cycle(base: _Cohorts, step: float, ref: float, x: np.ndarray) -> tuple[_Cohorts, dict, np.ndarray | None]:
+def _carried_cycle(base: _Cohorts, step: float, ref: float,
+                   x: np.ndarray) -> tuple[_Cohorts, dict, np.ndarray | None]:
     """The cycle map on the delta_R marginal after a shock, with the blocks the shock left
     unjumped carried along: one cycle (steps of ``step``, graded to ``ref``) from a copy of
     the state ``base`` just after a shock, its newborns' marginal replaced by ``x`` (scaled
@@ -446,7 +447,7 @@ def _frozen_cycle(model: Model, V: float, h: float, sigma: float, steps, x: np.n
 
     With the slips given, where each member crosses does not depend on the density, so
     this is linear in ``x`` (up to the floors' kink rule, which keeps each cell's surviving
-    mass: :func:`_band_jacobian`); from the cycle's own start it repeats the cycle."""
+    mass: :func:`_band_preconditioner`); from the cycle's own start it repeats the cycle."""
     st = _Cohorts(model, V, h)
     st.sigma = sigma
     st.add(x)
@@ -846,13 +847,13 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         # cycle: the slowest multiplier is about exp(-0.19 T); from 0.7 V^c down a ratio
         # above 0.9 is noise, and the acceleration there cost more than it saved)
         if not accelerated and slow and out["period"] < SHORT_PHASE and out["unjumped"] <= ANDERSON_UNJUMPED:
-            # a product state contracting slowly (close to V^c): accelerate it,
-            # then verify the result by the plain cycles again (with at least half the
+            # a state after all but total shocks contracting slowly (close to V^c): solve
+            # the fixed point, then verify it by the plain cycles again (with at least half the
             # cycles left: below the map's roughness, about 1e-6 of the mass at tol = 1e-6,
             # Anderson's residual creeps down without stalling and used to take them all)
             accelerated = True
-            fast, used, slow_multiplier = _anderson(model, V, h, step, dt, st, st.period_ref, ANDERSON_TOL * tol,
-                                    max((int(max_iter) - it) // 2, 1))
+            fast, used, slow_multiplier = _anderson(model, V, h, step, dt, st, st.period_ref,
+                                                    ANDERSON_TOL * tol, max((int(max_iter) - it) // 2, 1))
             it += used
             if fast is not None:
                 st = fast
