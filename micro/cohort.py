@@ -405,7 +405,13 @@ def _product_cycle(model: Model, V: float, h: float, step: float, ref: float,
     ``step``, graded to the loading phase ``ref``) from the product state of Exp margins
     and the marginal ``x``.  Returns the state after it, the cycle's row and the
     normalised marginal of the blocks its shock made jump (None if the cycle failed)."""
-    st = _start(model, V, h, None, dep=x)
+    return _cycle_image(_start(model, V, h, None, dep=x), step, ref)
+
+
+def _cycle_image(st: _Cohorts, step: float, ref: float) -> tuple[_Cohorts, dict, np.ndarray | None]:
+    """One cycle of the state ``st`` just after a shock (steps of ``step``, graded to
+    ``ref``): the state after it, the cycle's row and the normalised marginal of the blocks
+    its shock made jump (None if the cycle failed)."""
     st.period_ref = ref
     out = _one_cycle(st, step)
     if not out["ok"]:
@@ -431,12 +437,7 @@ def _carried_cycle(base: _Cohorts, step: float, ref: float,
     st.n -= 1
     st.sigma += float((new - old) @ (st.ylo + np.arange(st.ny) * st.h))
     st.add(new)
-    st.period_ref = ref
-    out = _one_cycle(st, step)
-    if not out["ok"]:
-        return st, out, None
-    g = st.dense(st.n - 1)
-    return st, out, g / g.sum()
+    return _cycle_image(st, step, ref)
 
 
 def _frozen_cycle(model: Model, V: float, h: float, sigma: float, steps, x: np.ndarray) -> np.ndarray:
