@@ -830,8 +830,6 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         hist.append(tuple(out[name] for name in COLUMNS))
         log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f", it, out["sigma_max"],
                   out["sigma_min"], out["sigma_before"])
-        if len(hist) < WINDOW and not (eager and not accelerated):
-            continue
         if len(hist) >= WINDOW:
             errors, how, best, rho = _estimate(np.array(hist), tol)
             if accelerated and 0.0 < slow_multiplier < 1.0:
@@ -842,8 +840,10 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 errors = np.maximum(errors, last * slow_multiplier / (1.0 - slow_multiplier))
             error = float(errors[list(JUDGED)].max())
             slow = any(how[i] in ("Aitken", "slow") and rho[i] > SLOW_CAVEAT for i in JUDGED)
-        else:
+        elif eager and not accelerated:
             slow = True  # (the start's own run was accelerated: so is this one, at once)
+        else:
+            continue
         # (only a short loading phase makes the blocks' relaxation slow from cycle to
         # cycle: the slowest multiplier is about exp(-0.19 T); from 0.7 V^c down a ratio
         # above 0.9 is noise, and the acceleration there cost more than it saved)
