@@ -309,16 +309,22 @@ def test_sigma_max_is_the_peak_before_the_shock():
     assert res.converged and abs(res.sigma_max - res.sigma_before) < 1e-9
 
 
-def _near_vc_product_cycle():
-    """k0 = 1e-3, 0.95 V^c at twice the default steps and cells: a product state a few
-    cycles from the first shock's image, and its cycle."""
-    from micro.cohort import _product_cycle
+def _near_vc_state():
+    """k0 = 1e-3, 0.95 V^c at twice the default steps and cells: the state three cycles
+    from the first shock's image (just after a shock), with its model, V, h and step."""
     model = micro.Model(k0=0.001)
     V = 0.95 * micro.critical_velocity(model).Vc
     h, step = model.kappa * model.zbar / 10, 0.0032616871833801
     st = _start(model, V, h, None)
     for _ in range(3):
         _one_cycle(st, step)
+    return model, V, h, step, st
+
+
+def _near_vc_product_cycle():
+    """The product state of :func:`_near_vc_state`'s marginal, and its cycle."""
+    from micro.cohort import _product_cycle
+    model, V, h, step, st = _near_vc_state()
     x = st.dense(st.n - 1)
     x /= x.sum()
     _, out, g = _product_cycle(model, V, h, step, st.period_ref, x)
@@ -380,12 +386,7 @@ def test_the_carried_cycle_from_a_state_is_its_own_cycle():
     the count of blocks its shock left unjumped (it used to count the newborns too when
     storing them compacted the copy's cohorts: 0.99999 instead of 3e-34)."""
     from micro.cohort import _carried_cycle
-    model = micro.Model(k0=0.001)
-    V = 0.95 * micro.critical_velocity(model).Vc
-    h, step = model.kappa * model.zbar / 10, 0.0032616871833801
-    st = _start(model, V, h, None)
-    for _ in range(3):
-        _one_cycle(st, step)
+    _, _, _, step, st = _near_vc_state()
     plain = st.copy()
     row = _one_cycle(plain, step)
     state, carried, g = _carried_cycle(st, step, st.period_ref, st.dense(st.n - 1))
