@@ -68,8 +68,7 @@ def newton(G, x: np.ndarray, fd: float, iterations: int = 8) -> dict:
     """Newton's chord iteration on G(x) = x with the forward-difference Jacobian at ``x``."""
     t = time.perf_counter()
     g, out = G(x)
-    support = np.flatnonzero((x > 0.0) | (g > 0.0))
-    S = np.arange(max(support[0] - 2, 0), min(support[-1] + 3, x.size))
+    S = C._support(x, g)
     J = np.empty((S.size, S.size))
     for k, i in enumerate(S):
         xi = x.copy()

@@ -458,6 +458,13 @@ def _frozen_cycle(model: Model, V: float, h: float, sigma: float, steps, x: np.n
     return st.dense(st.n - 1)
 
 
+def _support(x: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """The nodes a map's Jacobian at ``x`` (image ``g``) lives on: where either has mass,
+    with two nodes of margin below and above."""
+    nodes = np.flatnonzero((x > 0.0) | (g > 0.0))
+    return np.arange(max(nodes[0] - 2, 0), min(nodes[-1] + 3, x.size))
+
+
 def _band_preconditioner(model: Model, V: float, h: float, G, x: np.ndarray, out: dict, g: np.ndarray):
     """``M``, approximately ``(I - J)^-1`` for the Jacobian ``J`` of the cycle map ``G``
     (x -> (state, row, image)) at ``x`` (its cycle ``out``, its image ``g``), and the
@@ -475,8 +482,7 @@ def _band_preconditioner(model: Model, V: float, h: float, G, x: np.ndarray, out
     the mean relaxes like a block; in the full map the stress follows it) is measured by
     one more cycle and put in; Anderson's mixing deals with the rest
     (docs/reference/micro_cohort.md, section 4)."""
-    S = np.flatnonzero((x > 0.0) | (g > 0.0))
-    S = np.arange(max(S[0] - 2, 0), min(S[-1] + 3, x.size))
+    S = _support(x, g)
     n = S.size
     L = np.zeros((n, n))
     for c in range(min(BAND_COLOURS, n)):
