@@ -392,6 +392,20 @@ def _step_too_long(period: float, step: float, dt: float) -> bool:
     return period < 0.8 * SHORT_PHASE / dt * step
 
 
+def _phase_step(period: float, dt: float) -> float:
+    """The step for loading phases of ``period`` at the time step ``dt``: ``dt``, or
+    ``dt * period / SHORT_PHASE`` where the phase is shorter than SHORT_PHASE."""
+    return dt * min(1.0, period / SHORT_PHASE)
+
+
+def _step_off(period: float, step: float, dt: float) -> bool:
+    """Whether the step ``step`` is off the one for loading phases of ``period``
+    (:func:`_phase_step`) by more than a quarter: too long (:func:`_step_too_long`), or too
+    short, left from a shorter phase of the transient (then the resolution would depend on
+    the path to the cycle, not on ``dt``)."""
+    return _step_too_long(period, step, dt) or step < 0.8 * _phase_step(period, dt)
+
+
 def _step_length(since: float, ref: float, dt: float, gamma: float) -> float:
     """The loading phase's step at time ``since`` after the last shock, graded to a loading
     phase of length ``ref`` (GRADED_MAX).  A function of the step's start only, so halving
@@ -796,7 +810,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if coarse.applicable:
             st = _continued(coarse, model, V, h)
             if st is not None:
-                step = min(dt, 0.5 * st.dt)  # (a step cut to the loading phase stays cut)
+                step = _phase_step(coarse.period, dt)  # (the coarse cycle's loading phase, SHORT_PHASE / dt steps)
             elif coarse.p is not None:
                 given = coarse
     if st is None:
@@ -826,10 +840,10 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if not out["period"] > 1e-9:
             applicable, message = False, "a shock started with no loading phase (the state is past its fold)"
             break
-        if _step_too_long(out["period"], step, dt):
+        if _step_off(out["period"], step, dt):
             # close to V^c the loading phase is short: resolve it with SHORT_PHASE / dt
             # steps, and start the sequence again at the new step
-            step = out["period"] * dt / SHORT_PHASE
+            step = _phase_step(out["period"], dt)
             hist.clear()
             passed = 0
             continue

@@ -102,6 +102,20 @@ def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
     assert seen["warm"] > 20 and seen["shocks"] == 2
 
 
+def test_a_short_loading_phase_gets_its_steps_from_the_cycle_not_from_the_transient():
+    # k0 = 0.3, 0.95 V^c: the transient's loading phases are shorter (0.16) than the
+    # cycle's (0.25).  The step must be the cycle's dt T / SHORT_PHASE, whatever phase the
+    # transient cut it to: it used to stay at 0.65 of that, so the resolution depended on
+    # the path to the cycle, not on dt
+    from micro import cohort
+    model = micro.Model(k0=0.3)
+    dt = 0.02
+    res = cycle_cohorts(model, 0.95 * micro.critical_velocity(model).Vc, dt=dt, h=model.kappa * model.zbar / 10,
+                        tol=1e-3)
+    assert res.converged and res.period < cohort.SHORT_PHASE
+    assert res.state.dt == pytest.approx(dt * res.period / cohort.SHORT_PHASE, rel=0.25)
+
+
 def test_a_shock_keeps_the_mean_lag_at_zero():
     """The blocks' mean lag behind the mean slip is zero at all times (the mean slip is
     their mean displacement).  After a total shock every margin is Exp(kappa zbar), so
