@@ -102,16 +102,18 @@ def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
     assert seen["warm"] > 20 and seen["shocks"] == 2
 
 
-def test_a_short_loading_phase_gets_its_steps_from_the_cycle_not_from_the_transient():
+@pytest.mark.parametrize("coarse", [True, False])
+def test_a_short_loading_phase_gets_its_steps_from_the_cycle_not_from_the_transient(coarse):
     # k0 = 0.3, 0.95 V^c: the transient's loading phases are shorter (0.16) than the
     # cycle's (0.25).  The step must be the cycle's dt T / SHORT_PHASE, whatever phase the
     # transient cut it to: it used to stay at 0.65 of that, so the resolution depended on
-    # the path to the cycle, not on dt
+    # the path to the cycle, not on dt.  With the coarse transient first, the fine run
+    # takes the coarse cycle's phase; without it, the run lengthens the step it had cut
     from micro import cohort
     model = micro.Model(k0=0.3)
     dt = 0.02
     res = cycle_cohorts(model, 0.95 * micro.critical_velocity(model).Vc, dt=dt, h=model.kappa * model.zbar / 10,
-                        tol=1e-3)
+                        tol=1e-3, start=None if coarse else _NO_COARSE)
     assert res.converged and res.period < cohort.SHORT_PHASE
     assert res.state.dt == pytest.approx(dt * res.period / cohort.SHORT_PHASE, rel=0.25)
 
