@@ -22,7 +22,7 @@ PARALLEL_COHORTS = 64
 
 
 @njit(cache=True)
-def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, co, j0, nn, off, q, m, ylo, h):
+def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, Ej, n, co, j0, nn, off, q, m, ylo, h):
     """Fill ``co`` for a step of length ``dt`` from time ``t`` (slip ``X``, stress ``sigma``):
     a member born with margin delta' crosses once delta' <= D0 + Dy delta_R + D1 dX, dX the
     step's slip (the step's drive, dashpot relaxation and redistribution in it).  Returns
@@ -36,12 +36,15 @@ def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, n, 
     for c in range(n):
         E = math.exp(-gamma * (t + dt - t0[c]))
         beta = 1.0 - r2 * (1.0 - E)
+        # the margin's response to the members' own last jumps, made on average a time
+        # -log(Ej) / gamma before t0 (the step they were born in)
+        beta_j = 1.0 - r2 * (1.0 - E * Ej[c])
         dX0 = X - X0[c]
         b0 = (f_th - sigma - k0 * V * dt - beta * (f_th - s0[c]) - kappa * dX0 + k2 * (J[c] * Edt + dX0 * (1.0 - Edt)))
-        co[c, 0] = beta
-        co[c, 1] = -b0 / beta  # D at y = 0
-        co[c, 2] = alpha * (1.0 - E) / beta  # dD/dy
-        co[c, 3] = -b1 / beta  # dD/ddX
+        co[c, 0] = beta_j
+        co[c, 1] = -b0 / beta_j  # D at y = 0
+        co[c, 2] = alpha * (1.0 - E) / beta_j  # dD/dy
+        co[c, 3] = -b1 / beta_j  # dD/ddX
         co[c, 4] = E
         # the smallest gap between the floor and the threshold at dX = 0: no member of
         # the cohort crosses while co[c, 3] * dX stays below it
@@ -404,7 +407,7 @@ def _commit_cohort(c, dX, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h,
                 if mass < 1e-18:
                     continue
                 yv = y0 + s * h
-                Btil = r2 * (1.0 - E)
+                Btil = 1.0 - beta  # (r2 (1 - E Ej): delta_R's response to the margin at birth)
                 Atil = yv * E + r2 * (1.0 - E) * (f_th - s0[c] + yv) + k2 * Jn
                 bad += deposit(dep, mass, Atil - Btil * mv, Btil, Dv - mv, lam, ylo, h)
         if crossed:

@@ -31,6 +31,9 @@ Shocks need not be total: the blocks a shock leaves unjumped stay in their cohor
 with raised floors (at k0 = 0.1 and 0.3 their cohorts live for many cycles, and the
 cost per cycle grows with them; cells whose blocks have all but crossed are dropped).
 The kernels sum the cohorts in parallel (numba threads) when there are many.
+A step's newborns made their jumps, on average, half a step before its end: their own
+relaxation (the terms in their margin at birth) starts there, which makes the method
+second order in ``dt`` (``AGE``; first order when it started at the step's end).
 Refinement variables: the time step ``dt`` and the cell width ``h`` (measured orders in
 benchmarks/micro_cohort_refinement.py).  Needs exponential jumps, and a loading phase
 that ends in a shock within ``20 kappa zbar / (k0 V)`` (otherwise ``applicable=False``).
@@ -114,6 +117,9 @@ WARM = 0.97
 MAX_CELLS = 3_000_000
 #: A last step d between cycles leaves at most STILL * d to go when they contract by 0.8 a cycle.
 STILL = 5.0
+#: The newborns of a step made their last jumps this fraction of it before its end, on
+#: average (they cross at a steady rate; the re-jumps are counted to the end).
+AGE = 0.5
 #: Passed as ``start``: begin from the first shock's image, without a coarser run first.
 _NO_COARSE = object()
 
@@ -128,7 +134,7 @@ class _Cohorts:
         half = int(math.ceil(45.0 * model.k2 * model.zbar / h)) + 8
         self.ylo, self.ny = -half * h, 2 * half
         cap = 1024
-        self.t0, self.X0, self.s0, self.J = (np.zeros(cap) for _ in range(4))
+        self.t0, self.X0, self.s0, self.J, self.Ej = (np.zeros(cap) for _ in range(5))
         self.j0, self.nn, self.off = (np.zeros(cap, np.int64) for _ in range(3))
         self.co = np.zeros((cap, 6))
         self.q, self.m = np.zeros(1 << 16), np.zeros(1 << 17)
@@ -145,8 +151,10 @@ class _Cohorts:
         self.period_ref = 0.0  # the loading phase the steps are graded to (0: none yet, uniform steps)
 
     # -------------------------------------------------------------- storage
-    def add(self, dep: np.ndarray) -> None:
-        """A new cohort born now, with node masses ``dep`` in delta_R and floors 0."""
+    def add(self, dep: np.ndarray, age: float = 0.0) -> None:
+        """A new cohort born now, with node masses ``dep`` in delta_R and floors 0; its
+        members' last jumps were made ``age`` ago on average (half the step they were born
+        in), and their margins have relaxed by that much since (``Ej``)."""
         idx = np.flatnonzero(dep > 0.0)
         if idx.size == 0:
             return
@@ -155,16 +163,16 @@ class _Cohorts:
         cells = b - a - 1
         floors = np.empty((cells, 4))
         floors[:] = (0.0, 0.0, 1.0, 0.0)  # (ends, no kink)
-        self._append((self.t, self.X, self.sigma, 0.0), a, np.column_stack([nodes[:-1], nodes[1:]]), floors)
+        self._append((self.t, self.X, self.sigma, 0.0, math.exp(-self.model.gamma * age)), a, np.column_stack([nodes[:-1], nodes[1:]]), floors)
 
-    def _append(self, scalars: tuple[float, float, float, float], j0: int, q: np.ndarray, m: np.ndarray) -> None:
-        """Store a cohort: its (t0, X0, s0, J), first node ``j0``, and per cell the density
+    def _append(self, scalars: tuple[float, float, float, float, float], j0: int, q: np.ndarray, m: np.ndarray) -> None:
+        """Store a cohort: its (t0, X0, s0, J, Ej), first node ``j0``, and per cell the density
         at both ends ``q`` (cells x 2) and the floor ``m`` (cells x 4)."""
         cells = q.shape[0]
         if self.n + 1 > self.t0.size or 2 * (self.pool + cells) > self.q.size or 4 * (self.pool + cells) > self.m.size:
             self.compact()
             if self.n + 1 > self.t0.size:
-                for name in ("t0", "X0", "s0", "J", "j0", "nn", "off"):
+                for name in ("t0", "X0", "s0", "J", "Ej", "j0", "nn", "off"):
                     old = getattr(self, name)
                     setattr(self, name, np.concatenate([old, np.zeros_like(old)]))
                 self.co = np.zeros((self.t0.size, 6))
@@ -173,7 +181,7 @@ class _Cohorts:
                 self.q = np.concatenate([self.q, np.zeros(extra)])
                 self.m = np.concatenate([self.m, np.zeros(2 * extra)])
         c, p = self.n, self.pool
-        self.t0[c], self.X0[c], self.s0[c], self.J[c] = scalars
+        self.t0[c], self.X0[c], self.s0[c], self.J[c], self.Ej[c] = scalars
         self.j0[c], self.nn[c], self.off[c] = j0, cells, p
         self.q[2 * p:2 * (p + cells)] = q.ravel()
         self.m[4 * p:4 * (p + cells)] = m.ravel()
@@ -185,7 +193,7 @@ class _Cohorts:
         st = _Cohorts.__new__(_Cohorts)
         st.__dict__.update(self.__dict__)
         n = max(self.n, 1)
-        for name in ("t0", "X0", "s0", "J", "j0", "nn", "off", "co"):
+        for name in ("t0", "X0", "s0", "J", "Ej", "j0", "nn", "off", "co"):
             setattr(st, name, getattr(self, name)[:n].copy())
         st.q, st.m = self.q[:2 * self.pool + 2].copy(), self.m[:4 * self.pool + 4].copy()
         return st
@@ -216,7 +224,7 @@ class _Cohorts:
                 CK.cell_survivors(lost.size, q[cut].ravel(), m[cut].ravel(), h, self.lam, lost)
                 st.outside += float(lost.sum())
             if hi > lo:
-                st._append((self.t0[c], self.X0[c], self.s0[c], self.J[c]), j0 + lo, q[lo:hi], m[lo:hi])
+                st._append((self.t0[c], self.X0[c], self.s0[c], self.J[c], self.Ej[c]), j0 + lo, q[lo:hi], m[lo:hi])
         st.t, st.X, st.sigma, st.last, st.last_dt, st.dt = self.t, self.X, self.sigma, self.last, self.last_dt, self.dt
         st.prev_rate = self.prev_rate
         st.period_ref = self.period_ref
@@ -260,7 +268,7 @@ class _Cohorts:
         q, m = np.zeros_like(self.q), np.zeros_like(self.m)
         keep = np.empty(max(self.n, 1), np.int64)
         i, p, dropped = CK.compact(self.n, self.j0, self.nn, self.off, self.q, self.m, cell, CELL_FLOOR, keep, q, m)
-        for name in ("t0", "X0", "s0", "J"):
+        for name in ("t0", "X0", "s0", "J", "Ej"):
             column = getattr(self, name)
             column[:i] = column[keep[:i]]
         self.dropped += dropped
@@ -271,7 +279,7 @@ class _Cohorts:
         md = self.model
         self.pending = dt
         return CK.coefficients(self.t, dt, self.X, self.sigma, self.V, md.k0, md.k1, md.k2, md.f_th, md.gamma,
-                               self.t0, self.X0, self.s0, self.J, self.n, self.co, self.j0, self.nn, self.off,
+                               self.t0, self.X0, self.s0, self.J, self.Ej, self.n, self.co, self.j0, self.nn, self.off,
                                self.q, self.m, self.ylo, self.h)
 
     def closure(self, dX: float) -> tuple[float, float]:
@@ -307,7 +315,7 @@ class _Cohorts:
         self.t += dt
         self.X += dX
         self.sigma += md.k0 * (self.V * dt - dX)
-        self.add(dep)
+        self.add(dep, AGE * dt)
 
     def shock_root(self, x0: float) -> float:
         """The slip of the shock: the closure's root beyond its positive minimum (after
