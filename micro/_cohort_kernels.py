@@ -1,12 +1,14 @@
 """Numba kernels of :mod:`micro.cohort` (the loading phase as cohorts of exponential margins).
 
 Layout: cohort ``c`` has scalars (birth time ``t0``, mean slip ``X0`` and stress ``s0`` at
-birth, the dashpot integral ``J``), and ``nn[c]`` cells of width ``h`` in delta_R starting
+birth, the dashpot integral ``J``, and ``Ej = exp(-gamma a)`` with ``a`` how long before
+``t0`` its members made their last jumps, on average), and ``nn[c]`` cells of width ``h`` in delta_R starting
 at node ``j0[c]``, stored from ``off[c]``: cell ``k`` keeps the density ``q`` at both of its
 ends (at ``2 (off + k)`` and ``2 (off + k) + 1``) and its floor ``m`` (in units of the margin
 at birth), piecewise linear with at most one kink: at ``4 (off + k)`` the values at the
 two ends, the kink's position (local coordinate; 1 when there is none) and the value
-there.  ``co[c]`` holds the step's coefficients: beta, the threshold ``D``
+there.  ``co[c]`` holds the step's coefficients: beta (the margin's response to the margin
+at birth, aged by ``a`` more than the rest), the threshold ``D``
 at delta_R = 0, dD/d(delta_R), dD/d(dX), exp(-gamma age), and the smallest gap between
 floor and threshold at dX = 0 (cohorts that cannot cross are skipped).
 """

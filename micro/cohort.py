@@ -163,7 +163,8 @@ class _Cohorts:
         cells = b - a - 1
         floors = np.empty((cells, 4))
         floors[:] = (0.0, 0.0, 1.0, 0.0)  # (ends, no kink)
-        self._append((self.t, self.X, self.sigma, 0.0, math.exp(-self.model.gamma * age)), a, np.column_stack([nodes[:-1], nodes[1:]]), floors)
+        scalars = (self.t, self.X, self.sigma, 0.0, math.exp(-self.model.gamma * age))
+        self._append(scalars, a, np.column_stack([nodes[:-1], nodes[1:]]), floors)
 
     def _append(self, scalars: tuple[float, float, float, float, float], j0: int, q: np.ndarray, m: np.ndarray) -> None:
         """Store a cohort: its (t0, X0, s0, J, Ej), first node ``j0``, and per cell the density
