@@ -89,7 +89,8 @@ def model_from_description(d: dict[str, Any]) -> micro.Model:
 
 def _numerics_description(numerics: micro.Numerics, model: micro.Model) -> dict[str, Any]:
     eps = micro.default_eps(model) if numerics.eps is None else float(numerics.eps)
-    return {"eps": eps, "theta_shift": float(numerics.theta_shift), "theta_relax": float(numerics.theta_relax)}
+    return {"eps": eps, "theta_shift": float(numerics.theta_shift), "theta_relax": float(numerics.theta_relax),
+            "cohort_dt": float(numerics.cohort_dt)}
 
 
 def _convergence_description(conv: micro.Convergence) -> dict[str, Any]:

@@ -134,6 +134,8 @@ def _model_options(p: argparse.ArgumentParser, *, k0_list: bool = False) -> None
     n = p.add_argument_group("numerics")
     n.add_argument("--eps", type=float, default=None,
                    help="bin width of delta_F and delta_R (default kappa*zbar/50; error ~ (eps/0.004)^2 * 1.4e-4 on a steady stress)")
+    n.add_argument("--cohort-dt", type=float, default=0.01,
+                   help="time step of --method cohort, in (0, 0.1] (default 0.01; --eps is its delta_R cell)")
     n.add_argument("--rtol", type=float, default=1e-2,
                    help="convergence: relative agreement of 3 cycles / stress means (default 1e-2, the paper's)")
     n.add_argument("--t-max", type=float, default=None, help="longest simulated time, <= 1e8 (default from the model's time scales)")
@@ -145,7 +147,7 @@ def _model(args, k0: float) -> Model:
 
 
 def _numerics(args) -> tuple[Numerics, Convergence]:
-    return Numerics(eps=args.eps), Convergence(rtol=args.rtol, t_max=args.t_max)
+    return Numerics(eps=args.eps, cohort_dt=args.cohort_dt), Convergence(rtol=args.rtol, t_max=args.t_max)
 
 
 def build_parser() -> argparse.ArgumentParser:

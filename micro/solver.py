@@ -57,16 +57,21 @@ def default_eps(model: Model) -> float:
 
 @dataclass(frozen=True)
 class Numerics:
-    """Discretisation: bin ``eps`` (default :func:`default_eps`), the step limits, and the
+    """Discretisation: bin ``eps`` (default :func:`default_eps`), the step limits, the
     memory the grid may take (``max_memory_gib``; beyond it a run raises
-    :class:`~micro.grid.GridTooLarge` instead of exhausting the machine)."""
+    :class:`~micro.grid.GridTooLarge` instead of exhausting the machine), and the cohort
+    method's time step ``cohort_dt`` (``method="cohort"``: its ``eps`` is the delta_R cell,
+    default kappa zbar / 20; both are its refinement variables)."""
 
     eps: float | None = None
     theta_shift: float = 0.5
     theta_relax: float = 0.5
     max_memory_gib: float = 4.0
+    cohort_dt: float = 0.01
 
     def __post_init__(self) -> None:
+        if not (math.isfinite(self.cohort_dt) and 0.0 < self.cohort_dt <= 0.1):
+            raise ValueError(f"cohort_dt must be a finite number in (0, 0.1], got {self.cohort_dt!r}")
         if not (math.isfinite(self.max_memory_gib) and self.max_memory_gib > 0.0):
             raise ValueError(f"max_memory_gib must be a finite number > 0, got {self.max_memory_gib!r}")
         if self.eps is not None and not (math.isfinite(self.eps) and self.eps > 0.0):
@@ -411,7 +416,7 @@ def _cycle(model: Model, V: float, numerics: Numerics, convergence: Convergence,
     fallback = "jumps are not exponential"
     if model.jumps.kind == KIND_EXPONENTIAL:
         if method == "cohort":
-            res = cycle_cohorts(model, V, h=eps, tol=tol, start=start)
+            res = cycle_cohorts(model, V, dt=numerics.cohort_dt, h=eps, tol=tol, start=start)
         else:
             res = cycle_fixed_point(model, V, eps, tol=tol, theta_shift=numerics.theta_shift,
                                     theta_relax=numerics.theta_relax, start=start)

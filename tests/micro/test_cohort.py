@@ -267,14 +267,25 @@ def test_cohort_rejects_bad_input():
         micro.stationary(micro.Model(k0=0.01), 1.0, method="cohorts")
 
 
-def test_cli_sweep_method_cohort(tmp_path):
-    """``micro sweep --method cohort`` writes the sweep's columns; ``--eps`` is its cell."""
+def test_cli_sweep_method_cohort(tmp_path, monkeypatch):
+    """``micro sweep --method cohort`` writes the sweep's columns; ``--eps`` is its cell and
+    ``--cohort-dt`` its time step (both reach the method)."""
     import pandas as pd
 
+    from micro import solver
     from micro.cli import main
 
+    seen = []
+
+    def spy(model, V, **kw):
+        seen.append(kw)
+        return cycle_cohorts(model, V, **kw)
+
+    monkeypatch.setattr(solver, "cycle_cohorts", spy)
     out = tmp_path / "cohort.csv"
-    assert main(["sweep", "--k0", "0.001", "--V", "20", "--method", "cohort", "--eps", "0.01", "--out", str(out)]) == 0
+    assert main(["sweep", "--k0", "0.001", "--V", "20", "--method", "cohort", "--eps", "0.01", "--cohort-dt", "0.02",
+                 "--out", str(out)]) == 0
+    assert seen and seen[0]["dt"] == 0.02 and seen[0]["h"] == 0.01
     row = pd.read_csv(out).iloc[0]
     assert row.regime == "stick-slip" and bool(row.converged) and row.eps == 0.01
     assert abs(row.sigma_min - micro.sigma_fast_limit(micro.Model(k0=0.001))) < 1e-4

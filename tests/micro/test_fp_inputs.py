@@ -48,6 +48,8 @@ def test_jump_distributions_reject_bad_parameters(make, match):
         (lambda: micro.Numerics(eps=math.nan), r"eps must be"),
         (lambda: micro.Numerics(theta_shift=1.5), r"theta_shift must be in \(0, 1\]"),
         (lambda: micro.Numerics(theta_relax=0.0), r"theta_relax must be in \(0, 2\]"),
+        (lambda: micro.Numerics(cohort_dt=0.0), r"cohort_dt must be a finite number in \(0, 0.1\]"),
+        (lambda: micro.Numerics(cohort_dt=0.5), r"cohort_dt must be a finite number in \(0, 0.1\]"),
         (lambda: micro.Convergence(rtol=0.0), r"rtol must be"),
         (lambda: micro.Convergence(n=1), r"n must be an integer >= 2"),
         (lambda: micro.Convergence(t_max=-1.0), r"t_max must be"),
