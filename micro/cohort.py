@@ -127,6 +127,10 @@ _NO_COARSE = object()
 class _Cohorts:
     """The state: the cohorts (module docstring), the time, the slip and the stress."""
 
+    #: A cohort's scalars (the kernels' layout), and its cells' layout.
+    SCALARS = ("t0", "X0", "s0", "J", "Ej")
+    LAYOUT = ("j0", "nn", "off")
+
     def __init__(self, model: Model, V: float, h: float) -> None:
         self.model, self.V, self.h = model, V, h
         self.lam = model.kappa * model.zbar
@@ -134,8 +138,10 @@ class _Cohorts:
         half = int(math.ceil(45.0 * model.k2 * model.zbar / h)) + 8
         self.ylo, self.ny = -half * h, 2 * half
         cap = 1024
-        self.t0, self.X0, self.s0, self.J, self.Ej = (np.zeros(cap) for _ in range(5))
-        self.j0, self.nn, self.off = (np.zeros(cap, np.int64) for _ in range(3))
+        for name in self.SCALARS:
+            setattr(self, name, np.zeros(cap))
+        for name in self.LAYOUT:
+            setattr(self, name, np.zeros(cap, np.int64))
         self.co = np.zeros((cap, 6))
         self.q, self.m = np.zeros(1 << 16), np.zeros(1 << 17)
         self.n = self.pool = 0
@@ -173,7 +179,7 @@ class _Cohorts:
         if self.n + 1 > self.t0.size or 2 * (self.pool + cells) > self.q.size or 4 * (self.pool + cells) > self.m.size:
             self.compact()
             if self.n + 1 > self.t0.size:
-                for name in ("t0", "X0", "s0", "J", "Ej", "j0", "nn", "off"):
+                for name in self.SCALARS + self.LAYOUT:
                     old = getattr(self, name)
                     setattr(self, name, np.concatenate([old, np.zeros_like(old)]))
                 self.co = np.zeros((self.t0.size, 6))
@@ -182,19 +188,24 @@ class _Cohorts:
                 self.q = np.concatenate([self.q, np.zeros(extra)])
                 self.m = np.concatenate([self.m, np.zeros(2 * extra)])
         c, p = self.n, self.pool
-        self.t0[c], self.X0[c], self.s0[c], self.J[c], self.Ej[c] = scalars
+        for name, value in zip(self.SCALARS, scalars):
+            getattr(self, name)[c] = value
         self.j0[c], self.nn[c], self.off[c] = j0, cells, p
         self.q[2 * p:2 * (p + cells)] = q.ravel()
         self.m[4 * p:4 * (p + cells)] = m.ravel()
         self.pool += cells
         self.n += 1
 
+    def _scalars(self, c: int) -> tuple[float, ...]:
+        """Cohort ``c``'s scalars, in the order of SCALARS."""
+        return tuple(float(getattr(self, name)[c]) for name in self.SCALARS)
+
     def copy(self) -> _Cohorts:
         """An independent copy (a snapshot to replay steps from)."""
         st = _Cohorts.__new__(_Cohorts)
         st.__dict__.update(self.__dict__)
         n = max(self.n, 1)
-        for name in ("t0", "X0", "s0", "J", "Ej", "j0", "nn", "off", "co"):
+        for name in self.SCALARS + self.LAYOUT + ("co",):
             setattr(st, name, getattr(self, name)[:n].copy())
         st.q, st.m = self.q[:2 * self.pool + 2].copy(), self.m[:4 * self.pool + 4].copy()
         return st
@@ -225,7 +236,7 @@ class _Cohorts:
                 CK.cell_survivors(lost.size, q[cut].ravel(), m[cut].ravel(), h, self.lam, lost)
                 st.outside += float(lost.sum())
             if hi > lo:
-                st._append((self.t0[c], self.X0[c], self.s0[c], self.J[c], self.Ej[c]), j0 + lo, q[lo:hi], m[lo:hi])
+                st._append(self._scalars(c), j0 + lo, q[lo:hi], m[lo:hi])
         st.t, st.X, st.sigma, st.last, st.last_dt, st.dt = self.t, self.X, self.sigma, self.last, self.last_dt, self.dt
         st.prev_rate = self.prev_rate
         st.period_ref = self.period_ref
@@ -269,7 +280,7 @@ class _Cohorts:
         q, m = np.zeros_like(self.q), np.zeros_like(self.m)
         keep = np.empty(max(self.n, 1), np.int64)
         i, p, dropped = CK.compact(self.n, self.j0, self.nn, self.off, self.q, self.m, cell, CELL_FLOOR, keep, q, m)
-        for name in ("t0", "X0", "s0", "J", "Ej"):
+        for name in self.SCALARS:
             column = getattr(self, name)
             column[:i] = column[keep[:i]]
         self.dropped += dropped
