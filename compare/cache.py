@@ -14,9 +14,10 @@ from __future__ import annotations
 import json
 import logging
 import os
-import tempfile
 from pathlib import Path
 from typing import Any
+
+from rsf.results import write_atomically
 
 __all__ = ["PointCache", "NullCache", "default_cache_dir"]
 
@@ -76,19 +77,10 @@ class PointCache:
         path = self.path(key)
         path.parent.mkdir(parents=True, exist_ok=True)
         text = json.dumps(record, allow_nan=True)  # key order kept: CSV columns do not depend on the cache
-        fd, tmp = tempfile.mkstemp(prefix=f".{key[:12]}.", suffix=".tmp", dir=path.parent)
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as fh:
-                fh.write(text)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            try:
-                os.unlink(tmp)
-            except FileNotFoundError:
-                pass
-            raise
+        # temporary file (.tmp: never counted as a record), fsync, rename; the mode a plain
+        # write would give (rsf.results.write_atomically)
+        write_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), fsync=True,
+                         suffix=".tmp")
         self.writes += 1
         return path
 

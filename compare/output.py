@@ -17,6 +17,8 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
+from rsf.results import write_atomically
+
 __all__ = ["MANIFEST", "check_folder", "ReportFolder"]
 
 MANIFEST = ".compare-report.json"
@@ -50,16 +52,10 @@ def check_folder(out: str | os.PathLike) -> Path:
 
 
 def _atomic(path: Path, write: Callable[[Path], None]) -> None:
-    """``write(tmp)`` to a temporary file beside ``path``, then rename it over ``path``."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+    """``write(tmp)`` to a temporary file beside ``path``, then rename it over ``path``; the
+    file is left as a plain write would leave it (the umask, an existing file's mode, a
+    symbolic link written through to its target: :func:`rsf.results.write_atomically`)."""
+    write_atomically(path, write)
 
 
 class ReportFolder:

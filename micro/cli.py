@@ -52,13 +52,14 @@ def _floats(text: str, name: str, low: float, high: float) -> list[float]:
 
 
 def _check_out(path: str, option: str = "--out") -> Path:
-    """The CSV can be written there: fail now, not after the computation."""
+    """The CSV can be written there: fail now, not after the computation.  A symbolic link
+    is checked (and later written) at its target."""
     if not path.strip():
         raise ValueError(f"{option} must name a CSV file, got {path!r}")
     out = Path(path)
     if out.is_dir():
         raise ValueError(f"{option} {path!r} is a directory; give a file name")
-    parent = out.parent
+    parent = Path(os.path.realpath(path)).parent
     if not parent.is_dir():
         raise ValueError(f"{option} {path!r}: the directory {str(parent)!r} does not exist")
     try:
@@ -71,12 +72,29 @@ def _check_out(path: str, option: str = "--out") -> Path:
 
 
 def _write_csv(frame: pd.DataFrame, out: Path) -> None:
-    """Atomically: a temporary file beside ``out``, renamed over it once complete."""
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+    """Atomically: a temporary file beside ``out``, renamed over it once complete, and left
+    as a plain write would leave it: a new file gets ``0o666 & ~umask`` (mkstemp creates
+    0600), an existing file keeps its mode, and a symbolic link stays a link (its target
+    gets the data).
+
+    The same logic is ``rsf.results.write_atomically`` (which compare uses); micro keeps
+    this copy because micro and rsf are independent packages and neither imports the other.
+    """
+    import stat
+
+    target = Path(os.path.realpath(out))
+    try:
+        mode = stat.S_IMODE(os.stat(target).st_mode)
+    except FileNotFoundError:
+        mask = os.umask(0o022)      # read the umask (only possible by setting it) ...
+        os.umask(mask)              # ... and put it back at once
+        mode = 0o666 & ~mask
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "w", newline="") as f:
             frame.to_csv(f, index=False)
-        os.replace(tmp, out)
+        os.chmod(tmp, mode)
+        os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)

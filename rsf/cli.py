@@ -12,7 +12,6 @@ converge or the integration failed (the CSV then says which, in the status/messa
 from __future__ import annotations
 
 import argparse
-import contextlib
 import logging
 import math
 import os
@@ -27,6 +26,7 @@ from .analysis import critical_velocity
 from .laws import PAPER_A, PAPER_B, PAPER_DC, HyperbolicLaw, LogLaw, TabulatedLaw, ViscoelasticLaw
 from ._validation import positive
 from .params import Protocol, SolverOptions, SpringSlider
+from .results import write_atomically
 from .state_laws import NagataLaw, SecondState
 from .solver import simulate, sweep
 
@@ -55,12 +55,13 @@ def _floats(text: str) -> list[float]:
 
 
 def _check_out(path: str | None, option: str) -> None:
-    """The CSV can be written there (``None`` or ``-``: standard output): fail before computing."""
+    """The CSV can be written there (``None`` or ``-``: standard output): fail before computing.
+    A symbolic link is checked (and later written) at its target."""
     if path is None or path == "-":
         return
     if not path.strip():
         raise ValueError(f"{option} must name a CSV file (or - for standard output), got {path!r}")
-    out = Path(path)
+    out = Path(os.path.realpath(path))
     if out.is_dir():
         raise ValueError(f"{option} {path!r} is a directory; give a file name")
     if not out.parent.is_dir():
@@ -71,6 +72,17 @@ def _check_out(path: str | None, option: str) -> None:
         os.unlink(probe)
     except OSError as exc:
         raise ValueError(f"{option} {path!r}: cannot write in {str(out.parent)!r} ({exc.strerror})") from None
+
+
+def _check_distinct(out: str | None, events: str | None) -> None:
+    """``--out`` and ``--events`` must not name one file (the events would overwrite the
+    series): compared after resolving links and relative paths."""
+    if out is None or events is None:
+        return
+    same = out == events if "-" in (out, events) else os.path.realpath(out) == os.path.realpath(events)
+    if same:
+        raise ValueError(f"--out and --events name the same file ({out!r} and {events!r}); "
+                         "give two different files")
 
 
 def _check_magnitudes(args: argparse.Namespace) -> None:
@@ -205,21 +217,19 @@ def _options(args: argparse.Namespace) -> SolverOptions:
 
 
 def _write(frame, out: str | None) -> None:
-    """To standard output, or atomically: a temporary file beside ``out``, renamed over it."""
+    """To standard output, or atomically (:func:`rsf.results.write_atomically`: the umask,
+    an existing file's mode and a symbolic link are respected).  The count of rows goes to
+    standard error, so that standard output carries nothing but data."""
     if out is None or out == "-":
         frame.to_csv(sys.stdout, index=False)
         return
-    target = Path(out)
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", newline="") as f:
+
+    def fill(tmp: Path) -> None:
+        with open(tmp, "w", newline="") as f:
             frame.to_csv(f, index=False)
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    print(f"wrote {len(frame)} rows to {out}")
+
+    write_atomically(out, fill)
+    print(f"wrote {len(frame)} rows to {out}", file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -315,6 +325,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         # everything is checked before anything is computed
         _check_out(args.out, "--out")
         _check_out(getattr(args, "events", None), "--events")
+        _check_distinct(args.out, getattr(args, "events", None))
         _check_magnitudes(args)
         if args.command == "critical":
             import pandas as pd
