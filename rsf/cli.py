@@ -160,7 +160,10 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
     t.add_argument("--table-v-column", default="V", help="velocity column (default V)")
     t.add_argument("--table-mu-column", default="sigma", help="friction column (default sigma)")
     t.add_argument("--table-where", default=None,
-                   help="pandas query selecting rows, e.g. \"regime == 'steady'\"")
+                   help="keep only the rows where this holds: comparisons of columns with numbers "
+                        "or strings (==, !=, <, <=, >, >=, in), joined by and, or, not, e.g. "
+                        "\"regime == 'steady'\" or \"k0 == 0.1 and V < 3\" (checked, never "
+                        "evaluated as code)")
 
 
 def _add_solver_options(p: argparse.ArgumentParser) -> None:
@@ -194,7 +197,21 @@ def _law(args: argparse.Namespace, k0: float):
     if args.table is None:
         raise ValueError("--law table needs --table FILE.csv")
     return TabulatedLaw.from_csv(args.table, args.table_v_column, args.table_mu_column,
-                                 args.table_where)
+                                 args.table_where, names=_TABLE_OPTIONS)
+
+
+#: The table options, as the messages of TabulatedLaw.from_csv name them.
+_TABLE_OPTIONS = {"path": "--table", "where": "--table-where", "v_column": "--table-v-column",
+                  "mu_column": "--table-mu-column"}
+
+
+def _check_law_options(args: argparse.Namespace) -> None:
+    """Options of the table law need --law table (else they would be ignored)."""
+    if args.law != "table":
+        for option, value in (("--table", args.table), ("--table-where", args.table_where)):
+            if value is not None:
+                raise ValueError(f"{option} is for --law table; got --law {args.law} (give --law table, "
+                                 f"or drop {option})")
 
 
 def _model(args: argparse.Namespace, k0: float) -> SpringSlider:
@@ -327,6 +344,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _check_out(getattr(args, "events", None), "--events")
         _check_distinct(args.out, getattr(args, "events", None))
         _check_magnitudes(args)
+        _check_law_options(args)
         if args.command == "critical":
             import pandas as pd
 

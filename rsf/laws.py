@@ -21,8 +21,10 @@ with its derivative).
 """
 from __future__ import annotations
 
+import ast
 import logging
 import math
+import operator
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
@@ -41,6 +43,7 @@ __all__ = [
     "TabulatedLaw",
     "CallableLaw",
     "paper_mu_inf",
+    "select_rows",
     "PAPER_A",
     "PAPER_B",
     "PAPER_DC",
@@ -405,6 +408,108 @@ class LogLaw(SteadyStateLaw):
 
 
 # --------------------------------------------------------------------------------------
+_COMPARISONS = {ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt,
+                ast.LtE: operator.le, ast.Gt: operator.gt, ast.GtE: operator.ge}
+_ARITHMETIC = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+               ast.Div: operator.truediv}
+_WHERE_HELP = ("comparisons of columns with numbers or strings (==, !=, <, <=, >, >=, in, "
+               "not in), joined by and, or, not")
+
+
+def select_rows(frame, where: str, name: str = "where"):
+    """The rows of ``frame`` (a pandas DataFrame) where ``where`` holds.
+
+    ``where`` may hold only comparisons of columns, numbers and strings (``==``, ``!=``,
+    ``<``, ``<=``, ``>``, ``>=``, chained as in ``0.1 < V <= 10``; ``in``/``not in`` a list
+    of constants), the arithmetic ``+ - * /`` between them, joined by ``and``, ``or``,
+    ``not`` and parentheses: for instance ``"regime == 'steady'"`` or
+    ``"k0 == 0.1 and V < 3"``.  Its syntax tree is checked node by node and evaluated here
+    on the columns (no ``eval``, no ``pandas.query``): calls, attributes, subscripts,
+    ``@`` references, lambdas and the like are refused with a ValueError, as are unknown
+    columns.  ``name`` is what the messages call the expression.
+    """
+    text = str(where)
+    shown = text if len(text) <= 80 else text[:77] + "..."
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except (SyntaxError, RecursionError, MemoryError) as exc:
+        raise ValueError(f"{name} {shown!r} is not a valid expression "
+                         f"({getattr(exc, 'msg', None) or type(exc).__name__}); use "
+                         f"{_WHERE_HELP}") from None
+
+    def refuse(node: ast.AST, what: str | None = None) -> ValueError:
+        piece = ast.get_source_segment(text.strip(), node) or type(node).__name__
+        return ValueError(f"{name} {shown!r}: {what or f'{piece!r} is not allowed'}; use {_WHERE_HELP}")
+
+    def value(node: ast.AST):
+        if isinstance(node, ast.Name):
+            if node.id not in frame.columns:
+                raise refuse(node, f"no column {node.id!r} (columns: "
+                                   f"{', '.join(map(str, frame.columns))})")
+            return frame[node.id].to_numpy()
+        if isinstance(node, ast.Constant) and type(node.value) in (int, float, str, bool):
+            return node.value
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+            operand = value(node.operand)
+            return -operand if isinstance(node.op, ast.USub) else +operand
+        if isinstance(node, ast.BinOp) and type(node.op) in _ARITHMETIC:
+            return _ARITHMETIC[type(node.op)](value(node.left), value(node.right))
+        raise refuse(node)
+
+    def constants(node: ast.AST) -> list:
+        if isinstance(node, (ast.List, ast.Tuple, ast.Set)):
+            out = []
+            for elt in node.elts:
+                item = value(elt)
+                if isinstance(item, np.ndarray):
+                    raise refuse(elt, "the list after 'in' must hold constants")
+                out.append(item)
+            return out
+        raise refuse(node, "'in' needs a list of constants, as in regime in ['steady', 'stick-slip']")
+
+    def test(node: ast.AST):
+        if isinstance(node, ast.BoolOp):
+            parts = [test(v) for v in node.values]
+            combine = np.logical_and if isinstance(node.op, ast.And) else np.logical_or
+            out = parts[0]
+            for part in parts[1:]:
+                out = combine(out, part)
+            return out
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
+            return np.logical_not(test(node.operand))
+        if isinstance(node, ast.Compare):
+            out = True
+            left = value(node.left)
+            for op, right_node in zip(node.ops, node.comparators):
+                if isinstance(op, (ast.In, ast.NotIn)):
+                    right = constants(right_node)
+                    hit = np.isin(left, right)
+                    out = np.logical_and(out, hit if isinstance(op, ast.In) else ~hit)
+                    continue
+                if type(op) not in _COMPARISONS:
+                    raise refuse(node, f"the comparison {type(op).__name__} is not allowed")
+                right = value(right_node)
+                out = np.logical_and(out, _COMPARISONS[type(op)](left, right))
+                left = right
+            return out
+        if isinstance(node, ast.Constant) and isinstance(node.value, bool):
+            return node.value
+        if isinstance(node, (ast.Name, ast.Constant, ast.BinOp)):
+            value(node)     # refuses what is not allowed in it first
+            raise refuse(node, f"{ast.get_source_segment(text.strip(), node)!r} is not a comparison")
+        raise refuse(node)
+
+    try:
+        with np.errstate(all="ignore"):
+            mask = test(tree.body)
+        mask = np.broadcast_to(np.asarray(mask, dtype=bool), (len(frame),))
+    except RecursionError:
+        raise ValueError(f"{name} {shown!r} is nested too deeply") from None
+    except TypeError as exc:        # e.g. a text column compared with a number
+        raise ValueError(f"{name} {shown!r} cannot be evaluated on these columns ({exc})") from None
+    return frame[mask]
+
+
 @dataclass(frozen=True, eq=False)
 class TabulatedLaw(SteadyStateLaw):
     r"""A steady-state law interpolated from data :math:`(V_i, \mu_i)`.
@@ -450,22 +555,70 @@ class TabulatedLaw(SteadyStateLaw):
 
     @classmethod
     def from_csv(cls, path: str | Path, v_column: str = "V", mu_column: str = "sigma",
-                 where: str | None = None) -> TabulatedLaw:
+                 where: str | None = None, *, names: dict[str, str] | None = None) -> TabulatedLaw:
         """Read a table from a CSV file with columns ``v_column`` and ``mu_column``.
 
-        ``where`` is an optional pandas query applied first, for instance
-        ``"regime == 'steady'"`` to keep only the steady rows of a sweep.
+        ``where`` optionally keeps some rows first: comparisons of columns with numbers or
+        strings, joined by ``and``, ``or``, ``not`` (see :func:`select_rows`), for instance
+        ``"regime == 'steady'"`` to keep only the steady rows of a sweep, or
+        ``"V > 1 and k0 == 0.1"``.  It is checked and evaluated by rsf itself, never by
+        ``eval`` or ``pandas.query``.
+
+        Every problem (a missing or unreadable file, a folder, a bad ``where``, a missing
+        column, fewer than two rows) raises one ValueError.  ``names`` maps the argument
+        names (``path``, ``where``, ``v_column``, ``mu_column``) to the names the messages
+        use (the command line passes its options).
         """
         import pandas as pd
 
-        frame = pd.read_csv(path)
+        name = {"path": "path", "where": "where", "v_column": "v_column", "mu_column": "mu_column",
+                **(names or {})}
+        text = str(path)
+        if Path(text).is_dir():
+            raise ValueError(f"{name['path']} {text!r} is a folder, not a CSV file")
+        try:
+            frame = pd.read_csv(path)
+        except OSError as exc:
+            raise ValueError(f"{name['path']} {text!r} cannot be read "
+                             f"({exc.strerror or type(exc).__name__})") from None
+        except (UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+            reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            raise ValueError(f"{name['path']} {text!r} is not a readable CSV file ({reason})") from None
         if where is not None:
-            frame = frame.query(where)
-        for column in (v_column, mu_column):
+            frame = select_rows(frame, where, name=name["where"])
+        for column, key in ((v_column, "v_column"), (mu_column, "mu_column")):
             if column not in frame.columns:
-                raise ValueError(f"column {column!r} not in {str(path)!r}; available: "
+                raise ValueError(f"{name[key]}: column {column!r} not in {text!r}; available: "
                                  f"{', '.join(map(str, frame.columns))}")
-        return cls(frame[v_column].to_numpy(float), frame[mu_column].to_numpy(float))
+        if len(frame) < 2:
+            kept = f" after {name['where']} {where!r}" if where is not None else ""
+            raise ValueError(f"{name['path']} {text!r} has {len(frame)} row(s){kept}; a table needs "
+                             f"at least 2")
+        values = []
+        for column, key in ((v_column, "v_column"), (mu_column, "mu_column")):
+            try:
+                values.append(frame[column].to_numpy(float))
+            except (TypeError, ValueError):
+                raise ValueError(f"{name[key]}: column {column!r} of {text!r} must hold numbers") from None
+        try:
+            return cls(*values)
+        except ValueError as exc:
+            raise ValueError(f"{name['path']} {text!r}: {exc}") from None
+
+    def check_velocities(self, velocities, what: str = "V") -> bool:
+        """Warn (one logging warning) if some of ``velocities`` lie outside the table, where
+        the law is held flat (the friction of the nearest end, no weakening).  Returns
+        whether all lie inside."""
+        v = np.atleast_1d(np.asarray(velocities, dtype=float)).ravel()
+        v = v[np.isfinite(v) & (v > 0.0)]
+        outside = v[(v < self.V[0]) | (v > self.V[-1])]
+        if outside.size:
+            shown = ", ".join(f"{x:g}" for x in np.unique(outside)[:5])
+            more = f" and {np.unique(outside).size - 5} more" if np.unique(outside).size > 5 else ""
+            logger.warning("%s = %s%s outside the table's velocities [%g, %g]: the law is held flat "
+                           "there (the friction at the nearest end, no velocity weakening)",
+                           what, shown, more, self.V[0], self.V[-1])
+        return not outside.size
 
     @cached_property
     def _pchip(self):
