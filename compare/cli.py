@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
 import signal
 import sys
 import threading
@@ -31,10 +32,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scenario", action="append", choices=SCENARIOS, metavar="NAME",
                    help=f"run only this scenario (repeatable): {', '.join(SCENARIOS)}; default all")
     p.add_argument("--k0", type=float, nargs="+", metavar="K0",
-                   help="k0 of the micro bifurcation diagram (the RS side always shows the paper's five)")
-    p.add_argument("--eps", type=float, help="micro bin eps (smaller: more accurate, cost ~ eps^-2.6)")
-    p.add_argument("--dc", type=float, metavar="DC", help="use this D_c instead of fitting it")
-    p.add_argument("--workers", type=int, help="local worker processes (default: all cores; 1: serial)")
+                   help=f"k0 of the micro bifurcation diagram, each in (0, {K0_MAX:g}) (the RS side always "
+                        "shows the paper's five)")
+    p.add_argument("--eps", type=float, help="micro bin eps > 0 (smaller: more accurate, cost ~ eps^-2.6)")
+    p.add_argument("--dc", type=float, metavar="DC", help="use this D_c > 0 instead of fitting it")
+    p.add_argument("--workers", type=int, help="local worker processes >= 1 (default: all cores; 1: serial)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="dask.distributed scheduler address, e.g. tcp://host:8786 (needs the 'dask' extra)")
     p.add_argument("--cache-dir", metavar="DIR",
@@ -42,7 +44,28 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.add_argument("-v", "--verbose", action="count", default=0, help="more logging (-v info, -vv debug)")
+    p.epilog = (f"Limits: --k0 in (0, {K0_MAX:g}), --eps and --dc > 0, --workers >= 1.  Exit status: 0 "
+                "success, 2 bad input (one line on stderr), 130 interrupted.")
     return p
+
+
+#: k0 of the micro diagram must lie in (0, K0_MAX) (compare.Settings checks the same bound).
+K0_MAX = 10.0
+
+
+def _check_args(args: argparse.Namespace) -> None:
+    """The numbers the user typed, checked with the option's name before anything runs (the
+    messages of compare.Settings name its fields instead)."""
+    for i, k0 in enumerate(args.k0 or ()):
+        if not (math.isfinite(k0) and 0.0 < k0 < K0_MAX):
+            n = len(args.k0)
+            raise ValueError(f"--k0 must be in (0, {K0_MAX:g}), got {k0:g}"
+                             + (f" (value {i + 1} of {n})" if n > 1 else ""))
+    for option, value in (("--eps", args.eps), ("--dc", args.dc)):
+        if value is not None and not (math.isfinite(value) and value > 0.0):
+            raise ValueError(f"{option} must be a finite number > 0, got {value:g}")
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers must be an integer >= 1, got {args.workers}")
 
 
 def _terminate(signum, frame) -> None:
@@ -63,6 +86,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.scenario:
         changes["scenarios"] = tuple(args.scenario)
     try:
+        _check_args(args)
         factory = Settings.quick if args.quick else Settings.paper if args.paper else Settings.default
         settings = factory(**changes)
         with logging_redirect_tqdm():  # log lines above the progress bars, not glued to them

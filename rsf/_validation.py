@@ -5,22 +5,44 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["finite", "positive", "nonnegative", "in_range", "choice", "positive_int"]
+import numpy as np
+
+__all__ = ["finite", "positive", "nonnegative", "in_range", "choice", "positive_int", "shown",
+           "real"]
+
+
+def shown(value: object) -> str:
+    """``repr(value)`` with numpy scalars and arrays as plain Python numbers and lists, so
+    that a message reads ``got 1.0``, never ``got np.float64(1.0)``."""
+    if isinstance(value, np.generic):
+        return repr(value.item())
+    if isinstance(value, np.ndarray):
+        return repr(value.tolist())
+    return repr(value)
 
 
 def _as_float(name: str, value: object) -> float:
+    # strict: True, "1" and b"1" are not numbers, even though float() takes them
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise ValueError(f"{name} must be a real number, got {shown(value)}")
     try:
         result = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+        raise ValueError(f"{name} must be a real number, got {shown(value)}") from None
     return result
+
+
+def real(name: str, value: object) -> float:
+    """Return ``value`` as a float, or raise unless it is a real number (not a bool or a
+    string); nan and inf pass."""
+    return _as_float(name, value)
 
 
 def finite(name: str, value: object) -> float:
     """Return ``value`` as a float, or raise unless it is finite."""
     result = _as_float(name, value)
     if not math.isfinite(result):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
+        raise ValueError(f"{name} must be a finite number, got {shown(value)}")
     return result
 
 
@@ -28,7 +50,7 @@ def positive(name: str, value: object) -> float:
     """Return ``value`` as a float, or raise unless it is finite and > 0."""
     result = _as_float(name, value)
     if not (math.isfinite(result) and result > 0.0):
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+        raise ValueError(f"{name} must be a finite number > 0, got {shown(value)}")
     return result
 
 
@@ -36,7 +58,7 @@ def nonnegative(name: str, value: object) -> float:
     """Return ``value`` as a float, or raise unless it is finite and >= 0."""
     result = _as_float(name, value)
     if not (math.isfinite(result) and result >= 0.0):
-        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        raise ValueError(f"{name} must be a finite number >= 0, got {shown(value)}")
     return result
 
 
@@ -49,32 +71,30 @@ def in_range(name: str, value: object, low: float, high: float, *, low_open: boo
     if not (math.isfinite(result) and ok_low and ok_high):
         left = "(" if low_open else "["
         right = ")" if high_open else "]"
-        raise ValueError(f"{name} must lie in {left}{low!r}, {high!r}{right}, got {value!r}")
+        raise ValueError(f"{name} must lie in {left}{low:g}, {high:g}{right}, got {shown(value)}")
     return result
 
 
 def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
     """Return ``value`` if it is one of ``allowed``, or raise naming the choices."""
     if value not in allowed:
-        raise ValueError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {value!r}")
+        raise ValueError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {shown(value)}")
     return str(value)
 
 
 def positive_int(name: str, value: object) -> int:
     """Return ``value`` as an int, or raise unless it is an integer >= 1."""
-    if isinstance(value, bool) or not isinstance(value, (int,)) and not (
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int,)) and not (
         isinstance(value, float) and value.is_integer()
     ):
         try:
-            import numpy as np
-
             if isinstance(value, np.integer):
                 value = int(value)
             else:
                 raise TypeError
         except TypeError:
-            raise ValueError(f"{name} must be an integer >= 1, got {value!r}") from None
+            raise ValueError(f"{name} must be an integer >= 1, got {shown(value)}") from None
     result = int(value)  # type: ignore[arg-type]
     if result < 1:
-        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+        raise ValueError(f"{name} must be an integer >= 1, got {shown(value)}")
     return result

@@ -12,9 +12,11 @@ converge or the integration failed (the CSV then says which, in the status/messa
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import math
 import os
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -23,7 +25,8 @@ from typing import Sequence
 import numpy as np
 
 from .analysis import critical_velocity
-from .laws import PAPER_A, PAPER_B, PAPER_DC, HyperbolicLaw, LogLaw, TabulatedLaw, ViscoelasticLaw
+from .laws import (PAPER_A, PAPER_B, PAPER_DC, PAPER_K0_MAX, HyperbolicLaw, LogLaw, TabulatedLaw,
+                   ViscoelasticLaw)
 from ._validation import positive
 from .params import Protocol, SolverOptions, SpringSlider
 from .results import write_atomically
@@ -89,19 +92,19 @@ def _check_magnitudes(args: argparse.Namespace) -> None:
     k0s = args.k0 if isinstance(args.k0, list) else [args.k0]
     for k0 in k0s:
         if not (0.0 < k0 <= K0_MAX):
-            raise ValueError(f"--k0 must be in (0, {K0_MAX:g}], got {k0!r}")
+            raise ValueError(f"--k0 must be in (0, {K0_MAX:g}], got {k0:g}")
     for V in getattr(args, "V", None) if isinstance(getattr(args, "V", None), list) else [getattr(args, "V", None)]:
         if V is not None and not (0.0 < V <= V_MAX):
-            raise ValueError(f"--V must be in (0, {V_MAX:g}], got {V!r}")
+            raise ValueError(f"--V must be in (0, {V_MAX:g}], got {V:g}")
     t_end = getattr(args, "t_end", None)
     if t_end is not None and not (0.0 < t_end <= T_END_MAX):
-        raise ValueError(f"--t-end must be in (0, {T_END_MAX:g}], got {t_end!r}")
+        raise ValueError(f"--t-end must be in (0, {T_END_MAX:g}], got {t_end:g}")
     rng = getattr(args, "V_range", None)
     if rng is not None:
         vmin, vmax, n = rng
         if not (0 < vmin < vmax <= V_MAX and float(n).is_integer() and 1 <= n <= N_V_MAX):
             raise ValueError(f"--V-range needs 0 < VMIN < VMAX <= {V_MAX:g} and an integer N in [1, {N_V_MAX}], "
-                             f"got {vmin!r} {vmax!r} {n!r}")
+                             f"got {vmin:g} {vmax:g} {n:g}")
 
 
 def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> None:
@@ -111,9 +114,14 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
     g = p.add_argument_group("model")
     if k0_list:
         g.add_argument("--k0", type=_floats, required=True,
-                       help="driving stiffness k0 > 0 (comma-separated list allowed)")
+                       help=f"driving stiffness k0 in (0, {K0_MAX:g}] (comma-separated list allowed); "
+                            f"< {PAPER_K0_MAX:g} with the default --mu-inf or the viscoelastic law's "
+                            "defaults (the friction at large V, 0.95 - 0.05 k0, must be > 0)")
     else:
-        g.add_argument("--k0", type=float, required=True, help="driving stiffness k0 > 0")
+        g.add_argument("--k0", type=float, required=True,
+                       help=f"driving stiffness k0 in (0, {K0_MAX:g}]; < {PAPER_K0_MAX:g} with the default "
+                            "--mu-inf or the viscoelastic law's defaults (the friction at large V, "
+                            "0.95 - 0.05 k0, must be > 0)")
     g.add_argument("--Dc", type=float, default=PAPER_DC,
                    help=f"critical slip distance Dc > 0 (default {PAPER_DC}, the paper's)")
     g.add_argument("--law", choices=("hyperbolic", "viscoelastic", "log", "table"),
@@ -142,7 +150,7 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
     h.add_argument("--B", type=float, default=PAPER_B, help=f"velocity scale B > 0 (default {PAPER_B})")
     h.add_argument("--mu-inf", type=float, default=None,
                    help="large-velocity friction mu_inf (default: the paper's "
-                        "f_th - zbar (k0 + k1 + k2)/2 = 0.95 - 0.05 k0)")
+                        "f_th - zbar (k0 + k1 + k2)/2 = 0.95 - 0.05 k0, which needs k0 < 19)")
     v = p.add_argument_group("viscoelastic law, Eq. (4)")
     v.add_argument("--f-th", type=float, default=1.0, help="pinning threshold f_th (default 1)")
     v.add_argument("--zbar", type=float, default=0.1, help="mean well spacing zbar > 0 (default 0.1)")
@@ -156,7 +164,9 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
                     help="a of the log steady state mu0 + (a-b) ln(v/v0) (default 0.01)")
     lg.add_argument("--v0", type=float, default=1.0, help="reference velocity v0 > 0 (default 1)")
     t = p.add_argument_group("table law")
-    t.add_argument("--table", default=None, help="CSV file with a velocity and a friction column")
+    t.add_argument("--table", default=None,
+                   help="CSV file with a velocity and a friction column (with --law table only; "
+                        "outside its velocities the law is held flat, with a warning)")
     t.add_argument("--table-v-column", default="V", help="velocity column (default V)")
     t.add_argument("--table-mu-column", default="sigma", help="friction column (default sigma)")
     t.add_argument("--table-where", default=None,
@@ -168,12 +178,17 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
 
 def _add_solver_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("solver")
-    g.add_argument("--rtol", type=float, default=1e-10, help="CVODE relative tolerance (default 1e-10)")
-    g.add_argument("--atol", type=float, default=1e-12, help="CVODE absolute tolerance (default 1e-12)")
+    g.add_argument("--rtol", type=float, default=1e-10,
+                   help="CVODE relative tolerance, in [1e-14, 1e-2] (default 1e-10)")
+    g.add_argument("--atol", type=float, default=1e-12,
+                   help="CVODE absolute tolerance, in [1e-16, 1e-2] (default 1e-12)")
     g.add_argument("--cycle-rtol", type=float, default=1e-8,
                    help="limit cycle converged when sigma_max, sigma_min and the period change by "
-                        "less than this from one cycle to the next (default 1e-8)")
-    g.add_argument("--max-cycles", type=int, default=20000, help="give up after this many cycles")
+                        "less than this from one cycle to the next, in [1e-14, 0.1] (default 1e-8)")
+    g.add_argument("--max-cycles", type=int, default=20000,
+                   help="give up after this many cycles (default 20000): the row then says "
+                        "converged False, status -1 (MAX_CYCLES), and the run exits with 3; -v logs "
+                        "the cycles every 1000")
     g.add_argument("--no-accelerate", action="store_true",
                    help="simulate every cycle of the transient (no Aitken extrapolation)")
     g.add_argument("--v-max", type=float, default=None,
@@ -185,15 +200,45 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
                         "(default 20000000)")
 
 
+#: The API's parameter names and the options that set them (for the messages).
+_LAW_NAMES = {"k0": "--k0", "A": "--A", "B": "--B", "mu_inf": "--mu-inf", "f_th": "--f-th",
+              "zbar": "--zbar", "k1": "--k1", "k2": "--k2", "eta_u": "--eta-u", "mu0": "--mu0",
+              "a": "--law-a", "b": "--b", "v0": "--v0"}
+_MODEL_NAMES = {"k0": "--k0", "Dc": "--Dc", "a": "--a", "eta_rad": "--eta-rad", "c": "--nagata-c",
+                "b2": "--b2", "Dc2": "--Dc2", "state_law": "--state-law",
+                "second_state": "--b2 and --Dc2"}
+_SOLVER_NAMES = {"rtol": "--rtol", "atol": "--atol", "cycle_rtol": "--cycle-rtol",
+                 "max_cycles": "--max-cycles", "v_max": "--v-max", "max_rhs_evals": "--max-rhs-evals"}
+
+
+@contextlib.contextmanager
+def _named(names: dict[str, str]):
+    """Re-raise a ValueError of the API whose message starts with a parameter name with the
+    option's name instead (``Dc must be ...`` -> ``--Dc must be ...``)."""
+    try:
+        yield
+    except ValueError as exc:
+        text = str(exc)
+        match = re.match(r"[A-Za-z_][A-Za-z0-9_]*", text)
+        if match and match.group(0) in names and not text.startswith("--"):
+            raise ValueError(names[match.group(0)] + text[match.end():]) from None
+        raise
+
+
 def _law(args: argparse.Namespace, k0: float):
-    positive("k0", k0)
-    if args.law == "hyperbolic":
-        return HyperbolicLaw(A=args.A, B=args.B, mu_inf=args.mu_inf).bind(k0)
-    if args.law == "viscoelastic":
-        return ViscoelasticLaw(f_th=args.f_th, zbar=args.zbar, k1=args.k1, k2=args.k2,
-                               eta_u=args.eta_u, k0=k0)
-    if args.law == "log":
-        return LogLaw(mu0=args.mu0, a=args.law_a, b=args.b, v0=args.v0)
+    with _named(_LAW_NAMES):
+        positive("k0", k0)
+        if args.law == "hyperbolic":
+            if args.mu_inf is None and not k0 < PAPER_K0_MAX:
+                raise ValueError(f"--k0 must be < {PAPER_K0_MAX:g} with the default --mu-inf (0.95 - 0.05 k0, "
+                                 f"the friction at large V, would be {0.95 - 0.05 * k0:g}), got {k0:g}; "
+                                 "give --mu-inf for a stiffer spring")
+            return HyperbolicLaw(A=args.A, B=args.B, mu_inf=args.mu_inf).bind(k0)
+        if args.law == "viscoelastic":
+            return ViscoelasticLaw(f_th=args.f_th, zbar=args.zbar, k1=args.k1, k2=args.k2,
+                                   eta_u=args.eta_u, k0=k0)
+        if args.law == "log":
+            return LogLaw(mu0=args.mu0, a=args.law_a, b=args.b, v0=args.v0)
     if args.table is None:
         raise ValueError("--law table needs --table FILE.csv")
     return TabulatedLaw.from_csv(args.table, args.table_v_column, args.table_mu_column,
@@ -215,22 +260,28 @@ def _check_law_options(args: argparse.Namespace) -> None:
 
 
 def _model(args: argparse.Namespace, k0: float) -> SpringSlider:
-    state_law: object = args.state_law
-    if state_law == "nagata":
-        state_law = NagataLaw(c=args.nagata_c)
-    second = None
-    if (args.b2 is None) != (args.Dc2 is None):
-        raise ValueError("give both --b2 and --Dc2 for a second state variable")
-    if args.b2 is not None:
-        second = SecondState(args.b2, args.Dc2)
-    return SpringSlider(law=_law(args, k0), k0=k0, Dc=args.Dc, a=args.a, state_law=state_law,
-                        second_state=second, eta_rad=args.eta_rad)
+    law = _law(args, k0)
+    with _named(_MODEL_NAMES):
+        state_law: object = args.state_law
+        if state_law == "nagata":
+            if args.law != "log":
+                raise ValueError(f"--state-law nagata takes b from the log law: give --law log, "
+                                 f"got --law {args.law}")
+            state_law = NagataLaw(c=args.nagata_c)
+        second = None
+        if (args.b2 is None) != (args.Dc2 is None):
+            raise ValueError("give both --b2 and --Dc2 for a second state variable")
+        if args.b2 is not None:
+            second = SecondState(args.b2, args.Dc2)
+        return SpringSlider(law=law, k0=k0, Dc=args.Dc, a=args.a, state_law=state_law,
+                            second_state=second, eta_rad=args.eta_rad)
 
 
 def _options(args: argparse.Namespace) -> SolverOptions:
-    return SolverOptions(rtol=args.rtol, atol=args.atol, cycle_rtol=args.cycle_rtol,
-                         max_cycles=args.max_cycles, accelerate=not args.no_accelerate,
-                         v_max=args.v_max, max_rhs_evals=args.max_rhs_evals)
+    with _named(_SOLVER_NAMES):
+        return SolverOptions(rtol=args.rtol, atol=args.atol, cycle_rtol=args.cycle_rtol,
+                             max_cycles=args.max_cycles, accelerate=not args.no_accelerate,
+                             v_max=args.v_max, max_rhs_evals=args.max_rhs_evals)
 
 
 def _write(frame, out: str | None) -> None:
@@ -302,40 +353,147 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _number(option: str, value: float, low: float, high: float, *, open_low: bool = False) -> float:
+    """``value`` finite and in [low, high] (``(low, high]`` with ``open_low``), or one error
+    naming the option."""
+    ok = math.isfinite(value) and (value > low if open_low else value >= low) and value <= high
+    if not ok:
+        raise ValueError(f"{option} must be in {'(' if open_low else '['}{low:g}, {high:g}], got {value:g}")
+    return value
+
+
 def _protocol(args: argparse.Namespace) -> tuple[float | None, Protocol | None]:
+    """The driving of ``rsf run``, every number checked with the option's name (items
+    counted from 1)."""
     given = [x is not None for x in (args.V, args.steps, args.shs, args.history)]
     if sum(given) != 1:
         raise ValueError("give exactly one of --V, --steps, --shs, --history")
     if args.V is not None:
         return args.V, None
     if args.history is not None:
-        import pandas as pd
-
-        try:
-            frame = pd.read_csv(args.history)
-        except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-            raise ValueError(f"--history {args.history!r} cannot be read: {exc}") from None
-        if not {"t", "V"} <= set(frame.columns):
-            raise ValueError(f"--history needs columns t and V, got {list(frame.columns)}")
-        return None, Protocol.sampled(frame["t"].to_numpy(float), frame["V"].to_numpy(float))
+        return None, _history(args.history, args.t_end)
     if args.shs is not None:
         V, slide, hold = args.shs
+        _number("--shs V", V, 0.0, V_MAX, open_low=True)
+        _number("--shs SLIDE", slide, 0.0, T_END_MAX, open_low=True)
+        _number("--shs HOLD", hold, 0.0, T_END_MAX, open_low=True)
         return None, Protocol.slide_hold_slide(V, slide, hold)
     velocities, durations = [], []
-    for i, item in enumerate(args.steps.split(",")):
+    items = args.steps.split(",")
+    for i, item in enumerate(items):
         parts = item.split(":")
+        last = i == len(items) - 1
         try:
+            if len(parts) > 2 or (len(parts) == 1 and not last):
+                raise ValueError
             velocities.append(float(parts[0]))
             if len(parts) > 1:
                 durations.append(float(parts[1]))
         except ValueError:
-            raise ValueError(f"--steps item {i} must be velocity[:duration], got {item!r}") from None
-    return None, Protocol.velocity_steps(velocities, durations)
+            form = "velocity[:duration]" if last else "velocity:duration (only the last item may omit it)"
+            raise ValueError(f"--steps item {i + 1} of {len(items)} must be {form}, got {item!r}") from None
+        _number(f"--steps item {i + 1} velocity", velocities[-1], 0.0, V_MAX)
+        if len(parts) > 1:
+            _number(f"--steps item {i + 1} duration", durations[-1], 0.0, T_END_MAX, open_low=True)
+    if velocities[0] == 0.0:
+        raise ValueError("--steps must start with a velocity > 0 (the run starts from steady sliding)")
+    return None, Protocol.velocity_steps(velocities, durations[: len(velocities) - 1])
+
+
+def _history(path: str, t_end: float) -> Protocol:
+    """The sampled V(t) of ``--history``, checked row by row (rows counted from 1, as a
+    spreadsheet without its header)."""
+    import pandas as pd
+
+    if os.path.isdir(path):
+        raise ValueError(f"--history {path!r} is a folder, not a CSV file")
+    try:
+        frame = pd.read_csv(path)
+    except OSError as exc:
+        raise ValueError(f"--history {path!r} cannot be read ({exc.strerror or type(exc).__name__})") from None
+    except (UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ValueError(f"--history {path!r} is not a readable CSV file ({reason})") from None
+    if not {"t", "V"} <= set(frame.columns):
+        raise ValueError(f"--history needs columns t and V, got {', '.join(map(str, frame.columns))}")
+    if frame.empty:
+        raise ValueError(f"--history {path!r} has no rows")
+    columns = {}
+    for name in ("t", "V"):
+        try:
+            columns[name] = frame[name].to_numpy(float)
+        except (TypeError, ValueError):
+            raise ValueError(f"--history column {name} must hold numbers") from None
+    t, V = columns["t"], columns["V"]
+    if t[0] != 0.0:
+        raise ValueError(f"--history must start at t = 0, got t = {t[0]:g} in row 1")
+    for i in range(t.size):
+        if not math.isfinite(t[i]) or (i > 0 and not t[i] > t[i - 1]):
+            raise ValueError(f"--history times must increase strictly: row {i + 1} has t = {t[i]:g}"
+                             + (f" after {t[i - 1]:g}" if i > 0 else ""))
+        if not (math.isfinite(V[i]) and 0.0 <= V[i] <= V_MAX):
+            raise ValueError(f"--history velocities must be in [0, {V_MAX:g}]: row {i + 1} has V = {V[i]:g}")
+    if t[-1] < t_end:
+        logger.warning("--history ends at t = %g, before --t-end = %g: the driving holds its last "
+                       "velocity, V = %g, from there on", t[-1], t_end, V[-1])
+    return Protocol.sampled(t, V)
+
+
+def _t_eval(args: argparse.Namespace) -> np.ndarray | None:
+    """``--t-eval`` or ``--t-eval-n``, checked against ``--t-end`` with the options' names."""
+    if args.t_eval is not None and args.t_eval_n is not None:
+        raise ValueError("give at most one of --t-eval and --t-eval-n")
+    if args.t_eval_n is not None:
+        if not 2 <= args.t_eval_n <= 10_000_000:
+            raise ValueError(f"--t-eval-n must lie in [2, 10000000], got {args.t_eval_n}")
+        return np.linspace(0.0, args.t_end, args.t_eval_n)
+    if args.t_eval is None:
+        return None
+    times = args.t_eval
+    n = len(times)
+    for i, t in enumerate(times):
+        if not 0.0 <= t <= args.t_end:
+            raise ValueError(f"--t-eval item {i + 1} of {n} must be in [0, --t-end = {args.t_end:g}], "
+                             f"got {t:g}")
+        if i > 0 and not t > times[i - 1]:
+            raise ValueError(f"--t-eval must increase strictly: item {i + 1} of {n} is {t:g}, "
+                             f"after {times[i - 1]:g}")
+    return np.asarray(times, dtype=float)
+
+
+def _driving_velocities(V, protocol: Protocol | None) -> np.ndarray:
+    """The load-point velocities of a run (its nonzero ones for a protocol)."""
+    if protocol is None:
+        return np.atleast_1d(np.asarray(V, dtype=float))
+    return np.asarray(protocol.velocities)[np.asarray(protocol.velocities) > 0.0]
+
+
+def _option_values(argv: Sequence[str], parser: argparse.ArgumentParser) -> list[str]:
+    """``--t-eval -1,2`` as ``--t-eval=-1,2``: argparse takes a value that starts with a
+    minus for an option unless it is a plain negative number (``-1`` but not ``-1,2`` or
+    ``-1e-3``); joined to its option it is an ordinary value (and then checked)."""
+    takes_value = set()
+    actions = list(parser._actions)
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                actions.extend(sub._actions)
+    for action in actions:
+        if action.option_strings and action.nargs is None and not isinstance(
+                action, (argparse._StoreTrueAction, argparse._StoreFalseAction, argparse._HelpAction)):
+            takes_value.update(action.option_strings)
+    out: list[str] = []
+    for token in argv:
+        if (out and out[-1] in takes_value and re.match(r"^-(\d|\.\d|inf|nan)", token, re.IGNORECASE)):
+            out[-1] = f"{out[-1]}={token}"
+        else:
+            out.append(token)
+    return out
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_option_values(sys.argv[1:] if argv is None else list(argv), parser))
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
@@ -365,6 +523,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             else:
                 vmin, vmax, n = args.V_range
                 velocities = np.geomspace(vmin, vmax, int(n))
+            if isinstance(model.law, TabulatedLaw):
+                model.law.check_velocities(velocities, "--V")
             result = sweep(model, velocities, options=options, progress=args.verbose)
             _write(result.to_frame(), args.out)
             if not result.all_converged:
@@ -372,13 +532,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return 3
             return 0
         V, protocol = _protocol(args)
-        if args.t_eval is not None and args.t_eval_n is not None:
-            raise ValueError("give at most one of --t-eval and --t-eval-n")
-        t_eval = args.t_eval
-        if args.t_eval_n is not None:
-            if not 2 <= args.t_eval_n <= 10_000_000:
-                raise ValueError(f"--t-eval-n must lie in [2, 10000000], got {args.t_eval_n}")
-            t_eval = np.linspace(0.0, args.t_end, args.t_eval_n)
+        t_eval = _t_eval(args)
+        if isinstance(model.law, TabulatedLaw):
+            model.law.check_velocities(_driving_velocities(V, protocol), "the driving velocity V")
         traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
                         t_eval=t_eval)
         _write(traj.to_frame(), args.out)

@@ -56,6 +56,10 @@ PAPER_A = 0.007
 PAPER_B = 0.078
 #: The critical slip distance the paper uses for Fig. 8.
 PAPER_DC = 0.06
+#: Above this stiffness the paper's friction at large velocity, 0.95 - 0.05 k0 (Eq. 6 with
+#: its constants), is negative: the default mu_inf of HyperbolicLaw and the
+#: ViscoelasticLaw with its default constants refuse k0 >= 19.
+PAPER_K0_MAX = 19.0
 
 
 def paper_mu_inf(k0: float, f_th: float = 1.0, zbar: float = 0.1, k1: float = 0.1,
@@ -186,9 +190,17 @@ class HyperbolicLaw(SteadyStateLaw):
             object.__setattr__(self, "mu_inf", finite("mu_inf", self.mu_inf))
 
     def bind(self, k0: float) -> HyperbolicLaw:
+        """The law with the default ``mu_inf`` resolved for ``k0``.  The default, the paper's
+        :math:`0.95 - 0.05 k_0`, is a friction only while it is positive: ``k0`` >=
+        ``PAPER_K0_MAX`` (19) is refused (give ``mu_inf`` for a stiffer spring)."""
         if self.mu_inf is not None:
             return self
-        return replace(self, mu_inf=paper_mu_inf(k0))
+        mu_inf = paper_mu_inf(k0)
+        if not mu_inf > 0.0:
+            raise ValueError(f"k0 must be < {PAPER_K0_MAX:g} with the default mu_inf = 0.95 - 0.05 k0, "
+                             f"got k0 = {float(k0):g} (mu_inf = {mu_inf:g}, a negative friction); give "
+                             f"mu_inf for a stiffer spring")
+        return replace(self, mu_inf=mu_inf)
 
     @property
     def is_bound(self) -> bool:
@@ -273,6 +285,11 @@ class ViscoelasticLaw(SteadyStateLaw):
         object.__setattr__(self, "eta_u", positive("eta_u", self.eta_u))
         if self.k0 is not None:
             object.__setattr__(self, "k0", nonnegative("k0", self.k0))
+            if not self.mu_ref > 0.0:
+                k0_max = 2.0 * self.f_th / self.zbar - self.k1 - self.k2
+                raise ValueError(
+                    f"k0 must be < {k0_max:g} for this law (f_th - zbar (k0 + k1 + k2)/2, the friction "
+                    f"at large V, must be > 0), got k0 = {self.k0:g} (friction {self.mu_ref:g})")
 
     def bind(self, k0: float) -> ViscoelasticLaw:
         return self if self.k0 is not None else replace(self, k0=nonnegative("k0", k0))
@@ -606,18 +623,20 @@ class TabulatedLaw(SteadyStateLaw):
             raise ValueError(f"{name['path']} {text!r}: {exc}") from None
 
     def check_velocities(self, velocities, what: str = "V") -> bool:
-        """Warn (one logging warning) if some of ``velocities`` lie outside the table, where
-        the law is held flat (the friction of the nearest end, no weakening).  Returns
-        whether all lie inside."""
+        """Warn if some of ``velocities`` lie outside the table, where the law is held flat
+        (the friction of the nearest end, no weakening): one logging warning per law, the
+        first time (later ones are logged at DEBUG).  Returns whether all lie inside."""
         v = np.atleast_1d(np.asarray(velocities, dtype=float)).ravel()
         v = v[np.isfinite(v) & (v > 0.0)]
-        outside = v[(v < self.V[0]) | (v > self.V[-1])]
+        outside = np.unique(v[(v < self.V[0]) | (v > self.V[-1])])
         if outside.size:
-            shown = ", ".join(f"{x:g}" for x in np.unique(outside)[:5])
-            more = f" and {np.unique(outside).size - 5} more" if np.unique(outside).size > 5 else ""
-            logger.warning("%s = %s%s outside the table's velocities [%g, %g]: the law is held flat "
-                           "there (the friction at the nearest end, no velocity weakening)",
-                           what, shown, more, self.V[0], self.V[-1])
+            shown = ", ".join(f"{x:g}" for x in outside[:5])
+            more = f" and {outside.size - 5} more" if outside.size > 5 else ""
+            level = logging.DEBUG if self.__dict__.get("_warned") else logging.WARNING
+            object.__setattr__(self, "_warned", True)
+            logger.log(level, "%s = %s%s outside the table's velocities [%g, %g]: the law is held "
+                       "flat there (the friction at the nearest end, no velocity weakening)",
+                       what, shown, more, self.V[0], self.V[-1])
         return not outside.size
 
     @cached_property

@@ -19,8 +19,8 @@ from typing import Sequence
 
 import numpy as np
 
-from ._validation import choice, nonnegative, positive, positive_int
-from .laws import PAPER_DC, HyperbolicLaw, LogLaw, SteadyStateLaw
+from ._validation import choice, nonnegative, positive, positive_int, real, shown
+from .laws import PAPER_DC, HyperbolicLaw, LogLaw, SteadyStateLaw, TabulatedLaw
 from .state_laws import (
     AgingLaw,
     CallableStateLaw,
@@ -127,8 +127,13 @@ class SpringSlider:
         return self.k0 * self.Dc
 
     def sigma_steady(self, V: float) -> float:
-        r"""Friction of steady sliding at :math:`V`, :math:`\mu_{ss}(V)`."""
-        return float(self.law.mu_ss(positive("V", V)))
+        r"""Friction of steady sliding at :math:`V`, :math:`\mu_{ss}(V)` (a
+        :class:`~rsf.laws.TabulatedLaw` warns where it holds its end values, outside the
+        table)."""
+        V = positive("V", V)
+        if isinstance(self.law, TabulatedLaw):
+            self.law.check_velocities([V])
+        return float(self.law.mu_ss(V))
 
     def describe(self) -> dict[str, float | str]:
         """Parameters as a flat dict (for tables)."""
@@ -181,11 +186,19 @@ class Protocol:
             raise ValueError(f"times and velocities must be non-empty and of equal length, got "
                              f"{times.size} and {vel.size}")
         if times[0] != 0.0:
-            raise ValueError(f"times[0] must be 0, got {times[0]!r}")
-        if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0.0):
-            raise ValueError("times must be finite and strictly increasing")
-        if not np.all(np.isfinite(vel)) or np.any(vel < 0.0):
-            raise ValueError("velocities must be finite and >= 0")
+            raise ValueError(f"times[0] must be 0, got {float(times[0])!r}")
+        bad = ~np.isfinite(times)
+        bad[1:] |= ~(np.diff(times) > 0.0)
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            raise ValueError(f"times must be finite and strictly increasing: item {i + 1} of "
+                             f"{times.size} is {float(times[i])!r}"
+                             + (f", after {float(times[i - 1])!r}" if i > 0 else ""))
+        bad = ~np.isfinite(vel) | (vel < 0.0)
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            raise ValueError(f"velocities must be finite and >= 0: item {i + 1} of {vel.size} "
+                             f"is {float(vel[i])!r}")
         choice("interpolation", self.interpolation, ("previous", "linear"))
         times.setflags(write=False)
         vel.setflags(write=False)
@@ -320,15 +333,15 @@ class InitialState:
         if self.theta is not None:
             object.__setattr__(self, "theta", positive("theta", self.theta))
         if self.sigma is not None:
-            s = float(self.sigma)
+            s = real("sigma", self.sigma)
             if not math.isfinite(s):
-                raise ValueError(f"sigma must be a finite number, got {self.sigma!r}")
+                raise ValueError(f"sigma must be a finite number, got {shown(self.sigma)}")
             object.__setattr__(self, "sigma", s)
         if self.perturbation is None:
             return
-        pert = float(self.perturbation)
+        pert = real("perturbation", self.perturbation)
         if not (math.isfinite(pert) and pert > -1.0):
-            raise ValueError(f"perturbation must be a finite number > -1, got {self.perturbation!r}")
+            raise ValueError(f"perturbation must be a finite number > -1, got {shown(self.perturbation)}")
         object.__setattr__(self, "perturbation", pert)
 
 
@@ -404,9 +417,9 @@ class SolverOptions:
 
 def _as_positive_or_inf(name: str, value: object) -> float:
     try:
-        result = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number > 0 (or inf), got {value!r}") from None
+        result = real(name, value)
+    except ValueError:
+        raise ValueError(f"{name} must be a number > 0 (or inf), got {shown(value)}") from None
     if not result > 0.0:   # also rejects nan
-        raise ValueError(f"{name} must be a number > 0 (or inf), got {value!r}")
+        raise ValueError(f"{name} must be a number > 0 (or inf), got {shown(value)}")
     return result

@@ -128,3 +128,150 @@ def test_table_options_need_the_table_law(table, capsys):
     assert "--table is for --law table" in _error_line(capsys)
     assert main(["sweep", "--k0", "0.3", "--V", "1", "--law", "log", "--table-where", "V > 1"]) == 2
     assert "--table-where is for --law table" in _error_line(capsys)
+
+
+# --- row 10: physically meaningless input is refused, extrapolation is said -----------------
+def test_default_mu_inf_refuses_a_negative_friction(capsys):
+    # the call: sigma = -49 at k0 = 1e3, since 0.95 - 0.05 k0 < 0 for k0 > 19
+    assert main(["sweep", "--k0", "1e3", "--V", "1"]) == 2
+    line = _error_line(capsys)
+    assert "--k0 must be < 19 with the default --mu-inf" in line and "got 1000" in line
+    assert main(["sweep", "--k0", "1e3", "--V", "1", "--law", "viscoelastic"]) == 2
+    assert "--k0 must be < 19" in _error_line(capsys)
+    with pytest.raises(ValueError, match=r"k0 must be < 19 with the default mu_inf"):
+        rsf.SpringSlider(k0=19.0)
+    with pytest.raises(ValueError, match=r"k0 must be < 19 for this law"):
+        rsf.SpringSlider(rsf.ViscoelasticLaw(), k0=25.0)
+    # below the bound, or with mu_inf given, the model stands, and its friction is positive
+    assert rsf.SpringSlider(k0=18.9).sigma_steady(1e7) > 0.0
+    assert rsf.SpringSlider(rsf.HyperbolicLaw(mu_inf=0.5), k0=1e3).law.mu_inf == 0.5
+    assert "< 19 with the default --mu-inf" in " ".join(build_parser()._subparsers._group_actions[0]
+                                                        .choices["sweep"].format_help().split())
+
+
+def test_table_law_outside_its_velocities_warns_once(table, tmp_path, caplog):
+    out = tmp_path / "s.csv"
+    with caplog.at_level(logging.WARNING, logger="rsf"):
+        assert main(["sweep", "--k0", "0.3", "--law", "table", "--table", str(table),
+                     "--V", "0.001,1,1000,5000", "--out", str(out)]) == 0
+    flat = [r for r in caplog.records if "held flat" in r.getMessage()]
+    assert len(flat) == 1 and r"--V = 0.001, 1000, 5000" in flat[0].getMessage()
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="rsf"):
+        assert main(["sweep", "--k0", "0.3", "--law", "table", "--table", str(table),
+                     "--V", "0.1,1", "--out", str(out)]) == 0
+    assert not [r for r in caplog.records if "held flat" in r.getMessage()]
+
+
+def test_history_shorter_than_t_end_warns(tmp_path, caplog):
+    hist = tmp_path / "h.csv"
+    pd.DataFrame({"t": [0.0, 10.0], "V": [1.0, 2.0]}).to_csv(hist, index=False)
+    log = ["--law", "log", "--Dc", "10"]
+    with caplog.at_level(logging.WARNING, logger="rsf"):
+        assert main(["run", "--k0", "0.01", *log, "--history", str(hist), "--t-end", "20",
+                     "--out", str(tmp_path / "o.csv")]) == 0
+    held = [r.getMessage() for r in caplog.records if "holds its last" in r.getMessage()]
+    assert held == ["--history ends at t = 10, before --t-end = 20: the driving holds its last "
+                    "velocity, V = 2, from there on"]
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="rsf"):
+        assert main(["run", "--k0", "0.01", *log, "--history", str(hist), "--t-end", "10",
+                     "--out", str(tmp_path / "o.csv")]) == 0
+    assert not [r for r in caplog.records if "holds its last" in r.getMessage()]
+
+
+# --- row 11: messages name the option, count from 1, show plain numbers ----------------------
+@pytest.mark.parametrize("argv, message", [
+    (["run", "--k0", "0.3", "--steps", "1:5,2:-1,3", "--t-end", "10", "--out", "{out}"],
+     "error: --steps item 2 duration must be in (0, 1e+08], got -1"),
+    (["run", "--k0", "0.3", "--steps", "1:5,2,3", "--t-end", "10", "--out", "{out}"],
+     "error: --steps item 2 of 3 must be velocity:duration (only the last item may omit it), got '2'"),
+    (["run", "--k0", "0.3", "--steps", "1:0,3", "--t-end", "10", "--out", "{out}"],
+     "error: --steps item 1 duration must be in (0, 1e+08], got 0"),
+    (["run", "--k0", "0.3", "--shs", "1", "0", "2", "--t-end", "10", "--out", "{out}"],
+     "error: --shs SLIDE must be in (0, 1e+08], got 0"),
+    (["run", "--k0", "0.3", "--law", "log", "--V", "1", "--t-end", "10", "--t-eval", "-1,2", "--out", "{out}"],
+     "error: --t-eval item 1 of 2 must be in [0, --t-end = 10], got -1"),
+    (["run", "--k0", "0.3", "--law", "log", "--V", "1", "--t-end", "10", "--t-eval", "0,2,2", "--out", "{out}"],
+     "error: --t-eval must increase strictly: item 3 of 3 is 2, after 2"),
+    (["sweep", "--k0", "0.3", "--V", "1", "--Dc", "-1e-3"], "error: --Dc must be a finite number > 0, got -0.001"),
+    (["sweep", "--k0", "0.3", "--V", "1", "--law", "log", "--law-a", "-1"],
+     "error: --law-a must be a finite number >= 0, got -1.0"),
+    (["sweep", "--k0", "0.3", "--V", "1", "--a", "-1"], "error: --a must be a finite number >= 0, got -1.0"),
+    (["sweep", "--k0", "0.3", "--V", "1", "--mu-inf", "-inf"], "error: --mu-inf must be a finite number, got -inf"),
+    (["sweep", "--k0", "0.3", "--V", "1", "--rtol", "1"], "error: --rtol must lie in [1e-14, 0.01], got 1.0"),
+    (["sweep", "--k0", "0.3", "--V", "1", "--max-cycles", "0"], "error: --max-cycles must be an integer >= 1, got 0"),
+    (["sweep", "--k0", "0.3", "--V", "1", "--state-law", "nagata", "--a", "0.01"],
+     "error: --state-law nagata takes b from the log law: give --law log, got --law hyperbolic"),
+])
+def test_messages_name_the_option(argv, message, tmp_path, capsys):
+    argv = [x.format(out=tmp_path / "o.csv") for x in argv]
+    assert main(argv) == 2
+    line = _error_line(capsys)
+    assert line == message
+    assert "np." not in line and "[0]" not in line
+
+
+def test_history_messages_count_rows_from_1(tmp_path, capsys):
+    hist = tmp_path / "h.csv"
+    pd.DataFrame({"t": [0.0, 10.0, 5.0], "V": [1.0, 2.0, 1.0]}).to_csv(hist, index=False)
+    argv = ["run", "--k0", "0.01", "--law", "log", "--Dc", "10", "--history", str(hist), "--t-end", "20",
+            "--out", str(tmp_path / "o.csv")]
+    assert main(argv) == 2
+    assert _error_line(capsys) == "error: --history times must increase strictly: row 3 has t = 5 after 10"
+    pd.DataFrame({"t": [0.0, 10.0], "V": [1.0, -2.0]}).to_csv(hist, index=False)
+    assert main(argv) == 2
+    assert _error_line(capsys) == "error: --history velocities must be in [0, 1e+07]: row 2 has V = -2"
+
+
+def test_a_list_starting_with_a_minus_is_a_value(tmp_path):
+    # argparse took "-1,2" (and "-1e-3") for an option: "expected one argument"
+    out = tmp_path / "o.csv"
+    argv = ["run", "--k0", "0.3", "--law", "log", "--V", "1", "--t-end", "10", "--out", str(out)]
+    assert main([*argv, "--t-eval", "-1,2"]) == 2                                  # checked, not misparsed
+    assert main(["sweep", "--k0", "0.3", "--V", "1", "--mu-inf", "-1e-3", "--out", str(out)]) == 0
+    assert pd.read_csv(out).sigma_mean[0] == pytest.approx(-1e-3 + 0.007 / 1.078, abs=1e-12)
+    assert main([*argv, "--t-eval", "0,2.5"]) == 0 and list(pd.read_csv(out).t) == [0.0, 2.5]
+
+
+def test_api_messages_show_plain_numbers():
+    checks = [
+        (lambda: rsf.SpringSlider(k0=np.float64(-1.0)), "k0 must be a finite number > 0, got -1.0"),
+        (lambda: rsf.SolverOptions(rtol=np.float64(1.0)), "rtol must lie in [1e-14, 0.01], got 1.0"),
+        (lambda: rsf.Protocol(np.array([0.5, 1.0]), np.array([1.0, 1.0])), "times[0] must be 0, got 0.5"),
+        (lambda: rsf.Protocol(np.array([0.0, 1.0, 1.0]), np.array([1.0, 1.0, 1.0])),
+         "times must be finite and strictly increasing: item 3 of 3 is 1.0, after 1.0"),
+        (lambda: rsf.Protocol(np.array([0.0, 1.0]), np.array([1.0, -1.0])),
+         "velocities must be finite and >= 0: item 2 of 2 is -1.0"),
+        (lambda: rsf.InitialState(perturbation=np.float64(-2.0)), "perturbation must be a finite number > -1, got -2.0"),
+    ]
+    for make, message in checks:
+        with pytest.raises(ValueError) as exc:
+            make()
+        assert str(exc.value) == message and "np." not in str(exc.value)
+
+
+# --- row 12: strict types in the API ----------------------------------------------------------
+@pytest.mark.parametrize("make", [
+    lambda: rsf.SpringSlider(k0=True),
+    lambda: rsf.SpringSlider(k0="0.1"),
+    lambda: rsf.SpringSlider(k0=0.1, Dc=np.bool_(True)),
+    lambda: rsf.HyperbolicLaw(A=True),
+    lambda: rsf.LogLaw(b="0.01"),
+    lambda: rsf.SecondState(True, 1.0),
+    lambda: rsf.NagataLaw(c=False),
+    lambda: rsf.InitialState(theta=True),
+    lambda: rsf.InitialState(sigma="1"),
+    lambda: rsf.InitialState(perturbation=False),
+    lambda: rsf.SolverOptions(rtol=True),
+    lambda: rsf.SolverOptions(max_cycles=True),
+    lambda: rsf.SolverOptions(v_max=True),
+    lambda: rsf.limit_cycle(rsf.SpringSlider(k0=0.1), True),
+    lambda: rsf.simulate(rsf.SpringSlider(k0=0.1), V="1", t_end=1.0),
+    lambda: rsf.simulate(rsf.SpringSlider(k0=0.1), V=1.0, t_end=True),
+])
+def test_api_rejects_bools_and_strings_for_numbers(make):
+    with pytest.raises(ValueError) as exc:
+        make()
+    message = str(exc.value)
+    assert "\n" not in message and ("real number" in message or "integer" in message or "> 0" in message)
