@@ -137,6 +137,9 @@ class Trajectory:
         Samples (a slip appears as two samples at the same time), at the integrator's steps
         or at ``t_eval``.  ``sigma`` is the friction; with radiation damping the spring
         force is ``sigma + eta_rad * v``.
+    theta2 : ndarray or None
+        The second state variable at the same samples (a model with a
+        :class:`~rsf.state_laws.SecondState`), else None.
     events : list of Event
         Every event of the run.
     status : int
@@ -156,15 +159,18 @@ class Trajectory:
     status: int
     message: str
     params: dict[str, Any] = field(default_factory=dict)
+    theta2: np.ndarray | None = None
 
     @property
     def success(self) -> bool:
         return self.status >= 0
 
     def to_frame(self) -> pd.DataFrame:
-        """Columns t, x, sigma, theta, v."""
-        return pd.DataFrame({"t": self.t, "x": self.x, "sigma": self.sigma, "theta": self.theta,
-                             "v": self.v})
+        """Columns t, x, sigma, theta, v, and theta2 for two state variables."""
+        columns = {"t": self.t, "x": self.x, "sigma": self.sigma, "theta": self.theta, "v": self.v}
+        if self.theta2 is not None:
+            columns["theta2"] = self.theta2
+        return pd.DataFrame(columns)
 
     def events_frame(self) -> pd.DataFrame:
         """Columns t, kind, sigma, theta, x."""

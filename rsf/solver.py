@@ -48,6 +48,7 @@ _ZERO_PHASES = 20       # consecutive zero-length phases before giving up
 _TAU_CHUNK = 1e4        # length of one CVODE run in the slide time tau (and in units of
                         # the natural time scale for the a > 0 ODE)
 _RUNAWAY_FACTOR = 1e3   # default runaway bound: v_max = 1e3 max V (LogLaw models)
+_PROGRESS_CYCLES = 1000  # limit_cycle logs its progress (INFO) every this many cycles
 
 
 class _Kernels:
@@ -74,12 +75,18 @@ class _Samples:
     sigma: list = field(default_factory=list)
     theta: list = field(default_factory=list)
     v: list = field(default_factory=list)
+    theta2: list = field(default_factory=list)    # the second state variable, if any
 
-    def add(self, t, x, sigma, theta, v) -> None:
+    def add(self, t, x, sigma, theta, v, theta2=None) -> None:
         self.t.append(np.atleast_1d(np.array(t, dtype=float, copy=True)))
         n = self.t[-1].size
         for name, val in (("x", x), ("sigma", sigma), ("theta", theta), ("v", v)):
             getattr(self, name).append(np.broadcast_to(np.asarray(val, dtype=float), (n,)).copy())
+        if theta2 is not None:
+            self.theta2.append(np.broadcast_to(np.asarray(theta2, dtype=float), (n,)).copy())
+
+    def theta2_array(self) -> np.ndarray:
+        return np.concatenate(self.theta2) if self.theta2 else np.empty(0)
 
     def arrays(self) -> tuple[np.ndarray, ...]:
         if not self.t:
@@ -592,7 +599,8 @@ class _SmoothEngine:
         sigma = self.mu_ref + mu + m.a * (y[:, 0] + y[:, 1])
         if self.second is not None:
             sigma = sigma + self.second.b2 * (y[:, 5] + self.ln_v0)
-        self.samples.add(y[:, 4], y[:, 2], sigma, m.Dc * np.exp(y[:, 1]), v)
+        theta2 = None if self.second is None else self.second.Dc2 * np.exp(y[:, 5])
+        self.samples.add(y[:, 4], y[:, 2], sigma, m.Dc * np.exp(y[:, 1]), v, theta2)
 
     def _output_here(self) -> None:
         """Record the pending t_eval points that coincide with the current time."""
@@ -920,7 +928,8 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     message = STATUS_MESSAGES[status] + (f" ({detail})" if detail else "")
     if status < 0:
         logger.warning("simulate: %s", message)
-    return Trajectory(t=t, x=x, sigma=sigma, theta=theta, v=v, events=engine.events,
+    theta2 = engine.samples.theta2_array() if model.second_state is not None else None
+    return Trajectory(t=t, x=x, sigma=sigma, theta=theta, v=v, theta2=theta2, events=engine.events,
                       status=status, message=message, params=model.describe())
 
 
@@ -1061,7 +1070,13 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
                     result_cycle = cycles[-1]
                     if len(cycles) >= 2:
                         rel = _relative_change(cycles[-2], cycles[-1])
+                    detail = (f"{options.max_cycles} cycles; the last relative change {rel:.3g} against "
+                              f"cycle_rtol {options.cycle_rtol:.3g}")
                     break
+                if len(cycles) % _PROGRESS_CYCLES == 0:     # progress within a slow search
+                    logger.info("limit_cycle(V=%g): %d of at most %d cycles, relative change %.3g "
+                                "(converged below %.3g)", V, len(cycles), options.max_cycles,
+                                _relative_change(cycles[-2], cycles[-1]), options.cycle_rtol)
             sections.append(now[2])
             # Aitken extrapolation of the map section -> next section
             if (options.accelerate and since_restart >= 2 and len(sections) >= 3

@@ -275,3 +275,45 @@ def test_api_rejects_bools_and_strings_for_numbers(make):
         make()
     message = str(exc.value)
     assert "\n" not in message and ("real number" in message or "integer" in message or "> 0" in message)
+
+
+# --- row 5: next to the critical stiffness a sweep reports progress and ends in a status -----
+def test_slow_limit_cycle_reports_progress_and_ends_in_a_status(tmp_path, caplog, capsys, monkeypatch):
+    # the call (log law, k0 = 0.08333 next to k_c = (b - a)/Dc = 0.08333...): the cycle
+    # changes by ~1e-4 per cycle and never meets cycle_rtol; a progress line every
+    # _PROGRESS_CYCLES cycles (1000; 10 here to keep the test short), a row that says why
+    monkeypatch.setattr(rsf.solver, "_PROGRESS_CYCLES", 10)
+    out = tmp_path / "s.csv"
+    with caplog.at_level(logging.INFO, logger="rsf"):
+        code = main(["sweep", "--law", "log", "--k0", "0.08333", "--V", "1", "--max-cycles", "35",
+                     "--out", str(out)])
+    assert code == 3
+    progress = [r.getMessage() for r in caplog.records if "of at most 35 cycles" in r.getMessage()]
+    assert [m.split(": ")[1].split(" of")[0] for m in progress] == ["10", "20", "30"]
+    row = pd.read_csv(out).iloc[0]
+    assert (not row.converged) and row.status == rsf.Status.MAX_CYCLES
+    assert "not converged within max_cycles (35 cycles; the last relative change" in row.message
+    assert "not converged" in capsys.readouterr().err
+    helptext = " ".join(build_parser()._subparsers._group_actions[0].choices["sweep"].format_help().split())
+    assert "give up after this many cycles (default 20000)" in helptext
+
+
+# --- row 12: every state variable is written ---------------------------------------------------
+def test_two_state_run_writes_theta2(tmp_path):
+    out = tmp_path / "o.csv"
+    log = ["--law", "log", "--b", "0.01", "--law-a", "0.005", "--a", "0.005", "--v0", "1", "--Dc", "10",
+           "--mu0", "0.6"]
+    assert main(["run", "--k0", "0.01", *log, "--b2", "0.003", "--Dc2", "30", "--steps", "1:10,3",
+                 "--t-end", "60", "--t-eval-n", "7", "--out", str(out)]) == 0
+    series = pd.read_csv(out)
+    assert list(series.columns) == ["t", "x", "sigma", "theta", "v", "theta2"]
+    # theta2 starts at steady state for V = 1 (Dc2 / V) and relaxes to Dc2 / 3 after the step
+    assert series.theta2.iloc[0] == pytest.approx(30.0, rel=1e-12)
+    assert series.theta2.iloc[-1] == pytest.approx(10.0, rel=2e-2)
+    # the friction of Eq. (7) with both state variables is the column sigma
+    sigma = (0.6 + 0.005 * np.log(series.v) + 0.01 * np.log(series.theta / 10.0)
+             + 0.003 * np.log(series.theta2 / 30.0))
+    assert np.abs(sigma - series.sigma).max() < 1e-13
+    # one state variable: the columns are unchanged
+    assert main(["run", "--k0", "0.01", *log, "--steps", "1:10,3", "--t-end", "60", "--out", str(out)]) == 0
+    assert list(pd.read_csv(out).columns) == ["t", "x", "sigma", "theta", "v"]
