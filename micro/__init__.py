@@ -1,9 +1,14 @@
 r"""micro — the mean-field viscoelastic depinning model of Landes, Rosso & Jagla (2015).
 
-Steady sliding and its stability are solved directly, as the jump-to-jump renewal chain
-of one block (:mod:`micro.renewal`); transients, stick-slip cycles and slide-hold-slide
-by a Fokker-Planck (master) equation for the joint density P(delta_F, delta_R) at finite
-driving velocity (their Appendix B), with an independent N-block check.
+One call per question (:mod:`micro.api`), each answered by default by the best method
+for it: steady sliding, its stability and V^c by the jump-to-jump renewal chain of one
+block (:mod:`micro.renewal`, exact in milliseconds); stick-slip cycles by the cohort
+method (:mod:`micro.cohort`, fixed points of the cycle map, seconds at every k0);
+transients and slide-hold-slide by the Fokker-Planck equation for P(delta_F, delta_R)
+(:mod:`micro.fp`, the paper's Appendix B), also the fallback where nothing better
+applies; an independent event-driven N-block simulation (:mod:`micro.nblock`) checks
+them.  ``method=`` takes a name or an options object (:mod:`micro.methods`), and every
+result says which method produced it.
 
 The obvious entry points::
 
@@ -13,6 +18,7 @@ The obvious entry points::
     steady = micro.steady_sliding(model, [1.0, 5.0])   # steady branch: sigma, branching ratio, stability
     vc = micro.critical_velocity(model)                # V^c where the branching ratio reaches 1
     state = micro.stationary(model, 5.0)               # steady stress, or sigma_max / sigma_min
+    fine = micro.stationary(model, 5.0, method=micro.Cohort(dt=0.005))  # a method's own options
     table = micro.sweep(model, [1.0, 5.0, 20.0])       # one row per V
     peaks = micro.slide_hold_slide(model, 1000.0, [0.1, 1.0, 10.0])
 """
@@ -23,19 +29,9 @@ from .analytic import sigma_deterministic_steady, sigma_fast_limit, sigma_slow_l
 from .params import Deterministic, Exponential, JumpDistribution, Model, Tabulated
 from .protocols import Drive
 from .renewal import SteadySliding, characteristic_function, steady_sliding, unstable_mode_count, vc_small_k0
-from .solver import (
-    Convergence,
-    Critical,
-    Numerics,
-    Run,
-    Stationary,
-    critical_velocity,
-    default_eps,
-    simulate,
-    slide_hold_slide,
-    stationary,
-    sweep,
-)
+from .methods import FP, Auto, Cohort, Convergence, Numerics, Renewal, default_eps
+from .results import Critical, CycleFixedPoint, Run, Stationary
+from .api import critical_velocity, simulate, slide_hold_slide, stationary, sweep
 
 __all__ = [
     "Model",
@@ -44,11 +40,16 @@ __all__ = [
     "Deterministic",
     "Tabulated",
     "Drive",
+    "Auto",
+    "Renewal",
+    "Cohort",
+    "FP",
     "Numerics",
     "Convergence",
     "Run",
     "Stationary",
     "Critical",
+    "CycleFixedPoint",
     "SteadySliding",
     "steady_sliding",
     "characteristic_function",

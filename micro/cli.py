@@ -1,9 +1,12 @@
 """Command line: ``python -m micro steady|sweep|critical|run``.
 
 Defaults are the paper's Fig. 4 parameters (k1 = 0.1, k2 = 0.9, zbar = 0.1, exponential
-pinning distances with cutoff 10, eta_u = 1, f_th = 1).  The default bin eps is
-kappa*zbar/50 (2e-3 for these parameters); its error on a stationary stress is about
-1e-4 (second order in eps, see docs/reference/micro_numerics.md), coarser bins run much faster.
+pinning distances with cutoff 10, eta_u = 1, f_th = 1), and each question's best method
+(:mod:`micro.api`): the renewal chain for steady sliding and V^c, the cohort method for
+stick-slip cycles, the Fokker-Planck equation for a protocol's transient.  A method's
+options are flags of their own (``--eps`` the Fokker-Planck bin, ``--cohort-dt`` and
+``--cohort-h`` the cohort's step and cell); a flag for a method the command does not use
+is an error.
 """
 from __future__ import annotations
 
@@ -19,10 +22,11 @@ from pathlib import Path
 
 import pandas as pd
 
+from .api import critical_velocity, simulate, sweep
+from .methods import FP, RETIRED, Auto, Cohort, Convergence, default_eps
 from .params import Deterministic, Exponential, Model
 from .protocols import Drive
 from .renewal import steady_sliding
-from .solver import Convergence, Numerics, critical_velocity, default_eps, simulate, stationary
 
 log = logging.getLogger("micro")
 
@@ -149,14 +153,33 @@ def _model_options(p: argparse.ArgumentParser, *, k0_list: bool = False) -> None
                    help="pinning distances: exponential with cutoff 10 (default) or all equal to zbar")
     g.add_argument("--eta-u", type=float, default=1.0, help="dashpot viscosity, > 0 (default 1)")
     g.add_argument("--f-th", type=float, default=1.0, help="pinning threshold, > 0 (default 1)")
-    n = p.add_argument_group("numerics")
+    n = p.add_argument_group("method options (each only with a method that uses it)")
     n.add_argument("--eps", type=float, default=None,
-                   help="bin width of delta_F and delta_R (default kappa*zbar/50; error ~ (eps/0.004)^2 * 1.4e-4 on a steady stress)")
-    n.add_argument("--cohort-dt", type=float, default=0.01,
-                   help="time step of --method cohort, in (0, 0.1] (default 0.01; --eps is its delta_R cell)")
-    n.add_argument("--rtol", type=float, default=1e-2,
-                   help="convergence: relative agreement of 3 cycles / stress means (default 1e-2, the paper's)")
-    n.add_argument("--t-max", type=float, default=None, help="longest simulated time, <= 1e8 (default from the model's time scales)")
+                   help="Fokker-Planck bin of delta_F and delta_R (default kappa*zbar/50; error ~ (eps/0.004)^2 * "
+                        "1.4e-4 on a steady stress)")
+    n.add_argument("--rtol", type=float, default=None,
+                   help="Fokker-Planck stopping rule: relative agreement of 3 cycles / stress means "
+                        "(default 1e-2, the paper's)")
+    n.add_argument("--t-max", type=float, default=None,
+                   help="Fokker-Planck: longest simulated time, <= 1e8 (default from the model's time scales)")
+    n.add_argument("--cohort-dt", type=float, default=None,
+                   help="cohort method: time step, in (0, 0.1] (default 0.01; error second order in it)")
+    n.add_argument("--cohort-h", type=float, default=None,
+                   help="cohort method: delta_R cell, in (0, kappa*zbar/2] (default kappa*zbar/20)")
+    n.add_argument("--cohort-tol", type=float, default=None,
+                   help="cohort method: the fixed point's tolerance in stress, in [1e-9, 1e-2] (default 2e-5)")
+
+
+#: The flags of each method's options.
+FP_FLAGS = ("eps", "rtol", "t_max")
+COHORT_FLAGS = ("cohort_dt", "cohort_h", "cohort_tol")
+
+
+def _refuse(args, flags, why: str) -> None:
+    """One error naming the first of ``flags`` that was given, and why it does not apply."""
+    for name in flags:
+        if getattr(args, name, None) is not None:
+            raise ValueError(f"--{name.replace('_', '-')} {why}")
 
 
 def _model(args, k0: float) -> Model:
@@ -164,15 +187,30 @@ def _model(args, k0: float) -> Model:
     return Model(k0=k0, k1=args.k1, k2=args.k2, eta_u=args.eta_u, f_th=args.f_th, jumps=jumps)
 
 
-def _numerics(args) -> tuple[Numerics, Convergence]:
-    return Numerics(eps=args.eps, cohort_dt=args.cohort_dt), Convergence(rtol=args.rtol, t_max=args.t_max)
+def _fp_options(args) -> tuple[FP, Convergence]:
+    conv = Convergence() if args.rtol is None else Convergence(rtol=_bounded(args.rtol, "--rtol", 0.0, 1.0,
+                                                                              open_low=True))
+    if args.t_max is not None:
+        conv = Convergence(rtol=conv.rtol, t_max=_bounded(args.t_max, "--t-max", 0.0, T_MAX, open_low=True))
+    return FP(eps=args.eps), conv
+
+
+def _cohort_options(args) -> Cohort:
+    given = {k: v for k, v in (("dt", args.cohort_dt), ("h", args.cohort_h), ("tol", args.cohort_tol))
+             if v is not None}
+    try:
+        return Cohort(**given)
+    except ValueError as exc:  # (name the flag the user typed)
+        raise ValueError(str(exc).replace("Cohort dt", "--cohort-dt").replace("Cohort h", "--cohort-h")
+                         .replace("Cohort tol", "--cohort-tol")) from None
 
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="python -m micro",
-        description="Mean-field viscoelastic friction model (Landes, Rosso & Jagla 2015) solved as a "
-                    "Fokker-Planck equation for P(delta_F, delta_R) at finite driving velocity.",
+        description="Mean-field viscoelastic friction model (Landes, Rosso & Jagla 2015): steady sliding and "
+                    "V^c from the renewal chain, stick-slip cycles by the cohort method, transients by the "
+                    "Fokker-Planck equation for P(delta_F, delta_R).",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
     sub = p.add_subparsers(dest="command", required=True)
@@ -189,19 +227,19 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("sweep", help="stationary state for each drive velocity: one CSV row per V")
     _model_options(s)
     s.add_argument("--V", required=True, help="drive velocities, comma-separated, each in [1e-6, 1e7]")
-    s.add_argument("--method", choices=("auto", "fp", "cycle", "cohort"), default="auto",
-                   help="auto: steady rows from the renewal chain, others by Fokker-Planck time-stepping (default); "
-                        "fp: time-step every row; cycle: stick-slip rows as the fixed point of the shock-to-shock map "
-                        "(small k0; default eps kappa*zbar/8; falls back to time-stepping where shocks are not total); "
-                        "cohort: stick-slip rows by the grid-free cohort method, at any k0 (default delta_R cell "
-                        "kappa*zbar/20; falls back to time-stepping where jumps are not exponential)")
-    s.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,V,regime,sigma_max,sigma_min,sigma_mean,...")
+    s.add_argument("--method", default="auto", metavar="{auto,cohort,fp}",
+                   help="auto (default): steady rows from the renewal chain, stick-slip rows by the cohort method "
+                        "(seconds per row at every k0; the Fokker-Planck equation only for non-exponential jumps); "
+                        "cohort: the same, never the Fokker-Planck state; fp: time-step every row (minutes)")
+    s.add_argument("--out", required=True,
+                   help="output CSV, written after every row: k0,k1,k2,zbar,V,method,regime,sigma_max,sigma_min,"
+                        "sigma_mean,...,sigma_stderr,discretisation_error,...")
 
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
                                         "(--method fp: bisection on Fokker-Planck runs, the paper's Appendix B)")
     _model_options(c, k0_list=True)
-    c.add_argument("--method", choices=("renewal", "fp"), default="renewal",
-                   help="renewal (default): the direct solution, ~1e-10 relative in < 1 s; fp: bisection on "
+    c.add_argument("--method", choices=("auto", "renewal", "fp"), default="auto",
+                   help="auto = renewal (default): the direct solution, ~1e-10 relative in < 1 s; fp: bisection on "
                         "Fokker-Planck runs (minutes, uncertain by the bin)")
     c.add_argument("--V-min", type=float, default=1e-4, help="lower end of the bracket (default 1e-4)")
     c.add_argument("--V-max", type=float, default=None,
@@ -211,7 +249,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="decide oscillations smaller than 2 eps by their size and global shocks instead of "
                         "rerunning them at eps/2 (several times faster near Vc, but Vc then carries the "
                         "grid's error: k0=0.1, eps=0.016: 0.90 against 0.73)")
-    c.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,Vc,V_low,V_high,status")
+    c.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,Vc,V_low,V_high,status,message,method")
 
     r = sub.add_parser("run", help="stress time series of one protocol: columns t,w,sigma")
     _model_options(r)
@@ -237,19 +275,56 @@ def main(argv: list[str] | None = None) -> int:
         return 2
 
 
+def _options(args, models: list[Model]):
+    """The method's options from its flags, refusing flags of methods the command does
+    not use (all before anything is computed)."""
+    fp_used = {"steady": False, "sweep": args.command == "sweep", "critical": getattr(args, "method", "") == "fp",
+               "run": True}[args.command]
+    cohort_used = args.command == "sweep"
+    if args.command == "sweep":
+        if args.method in RETIRED:
+            raise ValueError(f"--method cycle was retired (its cycles are wrong close to V^c): use --method cohort, "
+                             "or auto (the default), which solves the same stick-slip cycles at every k0")
+        if args.method not in ("auto", "cohort", "fp"):
+            raise ValueError(f"--method must be auto, cohort or fp, got {args.method!r}")
+        cohort_used = args.method != "fp"
+        # the Fokker-Planck equation answers a sweep row of auto or cohort only for non-exponential jumps
+        fp_used = args.method == "fp" or args.dist != "exp"
+    if not cohort_used:
+        how = f" --method {args.method}" if getattr(args, "method", None) else ""
+        _refuse(args, COHORT_FLAGS, f"sets the cohort method, which `micro {args.command}{how}` does not use")
+    if not fp_used:
+        where = ("with exponential jumps, stick-slip rows come from the cohort method (--cohort-dt, --cohort-h) "
+                 "and steady rows from the renewal chain; --method fp time-steps every row"
+                 if args.command == "sweep" else
+                 f"`micro {args.command}{' --method ' + args.method if getattr(args, 'method', None) else ''}` "
+                 "does not use the Fokker-Planck equation")
+        _refuse(args, FP_FLAGS, f"sets the Fokker-Planck method: {where}")
+    if args.command == "run":
+        _refuse(args, ("rtol",), "sets the Fokker-Planck stopping rule; `micro run` runs for --duration")
+    fp_opts, convergence = _fp_options(args)
+    if fp_used:
+        for model in models:
+            fp_opts.settings(model)
+    cohort = _cohort_options(args) if cohort_used else None
+    if cohort is not None:
+        for model in models:
+            try:
+                cohort.cell(model)
+            except ValueError as exc:
+                raise ValueError(str(exc).replace("Cohort h", "--cohort-h")) from None
+    return fp_opts, convergence, cohort
+
+
 def _run(args) -> int:
     start = time.perf_counter()
     # everything is checked before anything is computed
     out = _check_out(args.out)
     k0s = _floats(args.k0, "k0", 0.0, K0_MAX) if args.command == "critical" else [args.k0]
+    if args.command != "critical" and not (math.isfinite(args.k0) and 0.0 < args.k0 <= K0_MAX):
+        raise ValueError(f"--k0 must be in (0, {K0_MAX:g}], got {args.k0:g}")
     models = [_model(args, k0) for k0 in k0s]
-    if models[0].k0 > K0_MAX:
-        raise ValueError(f"--k0 must be in (0, {K0_MAX:g}], got {args.k0!r}")
-    if args.t_max is not None:
-        _bounded(args.t_max, "--t-max", 0.0, T_MAX, open_low=True)
-    numerics, convergence = _numerics(args)
-    for model in models:
-        numerics.settings(model)
+    numerics, convergence, cohort = _options(args, models)
     if args.command == "steady":
         velocities = _floats(args.V, "V", *V_RANGE)
         res = steady_sliding(models[0], velocities, growth_rate=args.growth_rate)
@@ -260,19 +335,18 @@ def _run(args) -> int:
         return 0 if frame.converged.all() else 3
     if args.command == "sweep":
         velocities = _floats(args.V, "V", *V_RANGE)
-        rows = []
-        seed = "auto"  # with --method cycle or cohort, each row starts from the previous row's fixed point
-        for i, V in enumerate(velocities):
-            res = stationary(models[0], V, numerics=numerics, convergence=convergence, method=args.method,
-                             initial=seed)
-            if res.cycle is not None and res.cycle.applicable:
-                seed = res.cycle
-            rows.append(res.to_dict())
-            print(f"{_progress(i + 1, len(velocities), time.perf_counter() - start)} V={V:g}: {res.regime}, "
-                  f"sigma_max={res.sigma_max:.6f}, sigma_min={res.sigma_min:.6f}"
-                  f"{'' if res.converged else ' (NOT converged: ' + res.message + ')'}", file=sys.stderr)
-        frame = pd.DataFrame(rows)
-        _write_csv(frame, out)
+        method = {"auto": Auto(cohort=cohort), "cohort": cohort, "fp": "fp"}[args.method]
+
+        def row_done(frame: pd.DataFrame) -> None:
+            # the CSV holds every row computed so far: a later row that fails, or a kill, loses nothing
+            _write_csv(frame, out)
+            last = frame.iloc[-1]
+            print(f"{_progress(len(frame), len(velocities), time.perf_counter() - start)} V={last.V:g}: "
+                  f"{last.regime} ({last.method}), sigma_max={last.sigma_max:.6f}, sigma_min={last.sigma_min:.6f}"
+                  f"{'' if last.converged else ' (NOT converged: ' + last.message + ')'}", file=sys.stderr)
+
+        frame = sweep(models[0], velocities, method=method, numerics=numerics, convergence=convergence,
+                      on_row=row_done)
         print(f"wrote {len(frame)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0 if frame.converged.all() else 3
     if args.command == "critical":

@@ -48,8 +48,8 @@ import numpy as np
 import scipy.linalg
 
 from . import _cohort_kernels as CK
-from .cycle import CycleFixedPoint, _initial_marginal, _rows
 from .params import KIND_EXPONENTIAL, Model
+from .results import CycleFixedPoint
 
 __all__ = ["cycle_cohorts"]
 
@@ -57,6 +57,11 @@ log = logging.getLogger(__name__)
 
 _GX, _GW = np.polynomial.legendre.leggauss(2)
 _GX, _GW = 0.5 * _GX + 0.5, 0.5 * _GW
+#: The transient's fixed point (at twice the step and cell) is solved to this multiple of
+#: the run's tolerance, and at least to COARSE_FLOOR: its change to the run's own is the
+#: run's discretisation error, so its own error must stay below that change.
+COARSE_TOL = 4.0
+COARSE_FLOOR = 3e-4
 #: Cells whose surviving mass (a fraction of all blocks) is below this are dropped.
 CELL_FLOOR = 1e-13
 #: The start of a shock is located to this fraction of the time step.
@@ -353,6 +358,34 @@ class _Cohorts:
             else:
                 hi = x
         return hi
+
+
+# ------------------------------------------------------------------------------ the delta_R marginal
+def _rows(delta_R: np.ndarray, mass: np.ndarray, eps: float, j_lo: int, n_rows: int) -> tuple[np.ndarray, float]:
+    """The delta_R marginal as masses on the nodes ``(j_lo + i) eps``, each atom shared
+    linearly between its two neighbours (mass and first moment kept; the map is then
+    continuous in the atoms' positions); also the mass that fell outside the nodes."""
+    u = delta_R / eps - j_lo
+    i = np.floor(u).astype(np.int64)
+    f = u - i
+    x = np.zeros(n_rows)
+    outside = 0.0
+    for idx, w in ((i, mass * (1.0 - f)), (i + 1, mass * f)):
+        inside = (idx >= 0) & (idx < n_rows)
+        np.add.at(x, idx[inside], w[inside])
+        outside += float(w[~inside].sum())
+    return x, outside
+
+
+def _initial_marginal(model: Model, eps: float, j_lo: int, n_rows: int) -> np.ndarray:
+    """A start: every dashpot relaxed to the lag of an Exp(kappa zbar) margin, the
+    marginal of ``(k2 / kappa) (<delta> - delta)`` (the first shock's image)."""
+    lam = model.kappa * model.zbar
+    delta = (np.arange(4000) + 0.5) * (lam * 40.0 / 4000)
+    w = np.exp(-delta / lam)
+    y = model.k2 / model.kappa * (lam - delta)
+    x, _ = _rows(y, w / w.sum(), eps, j_lo, n_rows)
+    return x
 
 
 def _split_cells(q: np.ndarray, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -784,7 +817,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     """The stick-slip limit cycle at drive velocity ``V``, by the cohort method (module
     docstring), iterated cycle to cycle from ``start``: a result at a nearby V (same
     model) or at twice ``h`` of this method, whose whole state it continues, or a result
-    with a delta_R marginal (total shocks; also :func:`micro.cycle.cycle_fixed_point`'s).
+    with a delta_R marginal (total shocks; after a total shock).
     Without one, the transient cycles run at twice ``dt`` and ``h`` first (from the first
     shock's image), and their whole state, each cell split in two, is the start.  The
     sequence of cycle
@@ -825,7 +858,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         # the transient cycles at twice the steps and cells (an eighth of the cost), to a
         # looser tolerance: the fixed point there is the start (its whole state, with the
         # blocks its shocks left, each cell split in two)
-        coarse = cycle_cohorts(model, V, dt=2.0 * dt, h=2.0 * h, tol=max(4.0 * tol, 3e-4), max_iter=max_iter,
+        coarse = cycle_cohorts(model, V, dt=2.0 * dt, h=2.0 * h, tol=max(COARSE_TOL * tol, COARSE_FLOOR), max_iter=max_iter,
                                start=_NO_COARSE)
         if coarse.applicable:
             st = _continued(coarse, model, V, h)
@@ -868,8 +901,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             passed = 0
             continue
         hist.append(tuple(out[name] for name in COLUMNS))
-        log.debug("cohort cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f", it, out["sigma_max"],
-                  out["sigma_min"], out["sigma_before"])
+        # (INFO: the progress within a row that `micro sweep -v` shows; each cycle is one step of the iteration)
+        log.info("cohort k0=%g V=%g h=%.3g cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f",
+                 model.k0, V, h, it, out["sigma_max"], out["sigma_min"], out["sigma_before"])
         if len(hist) >= WINDOW:
             errors, how, best, rho = _estimate(np.array(hist), tol)
             if accelerated and 0.0 < slow_multiplier < 1.0:
@@ -929,8 +963,10 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         sigma_mean=float(value[3]), mass_error=float(st.outside + st.dropped), min_mass=0.0, iterations=it, error=error,
         unjumped=out.get("unjumped", math.nan), converged=converged, message=message,
         wall_time=time.perf_counter() - begin, applicable=applicable, history=values,
-        sigma_before=float(value[4]), sigma_after=float(value[5]))
-    res.accelerated = accelerated
+        sigma_before=float(value[4]), sigma_after=float(value[5]), accelerated=accelerated,
+        coarse=coarse if coarse is not None and coarse.applicable and coarse.converged else None)
+    if res.coarse is not None:
+        res.coarse.state = None  # (the fine run continued it; keep only its numbers)
     if applicable and len(hist):
         st.dt = step
         res.state = st

@@ -1,8 +1,8 @@
 """The discretised density P(delta_F, delta_R) and the loop that advances it.
 
-:class:`Grid` owns the arrays the numba kernels in :mod:`micro._kernels` work on: it
+:class:`Grid` owns the arrays the numba kernels in :mod:`micro._fp_kernels` work on: it
 allocates them, grows them when the density spreads, builds the initial densities and
-calls :func:`micro._kernels.advance` until a requested time, collecting what it records.
+calls :func:`micro._fp_kernels.advance` until a requested time, collecting what it records.
 """
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _kernels as K
+from . import _fp_kernels as K
 from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
 
 __all__ = ["Grid", "GridSettings"]

@@ -2,10 +2,12 @@ r"""
 A velocity sweep (micro)
 ========================
 
-:func:`micro.sweep` gives one row per driving velocity: where steady sliding is
-stable the row comes from the direct solver (exact, milliseconds), elsewhere the
-Fokker-Planck equation is time-stepped until the stick-slip cycle converges.  The
-same table is what ``python -m micro sweep`` writes.
+:func:`micro.sweep` gives one row per driving velocity, each from the best method for
+it: where steady sliding is stable the renewal chain (exact, milliseconds), elsewhere
+the stick-slip cycle by the cohort method (the fixed point of the cycle map, seconds).
+The ``method`` column says which; ``discretisation_error`` what the discretisation may
+have moved (NaN where it is not known, close to V^c).  The same table is what
+``python -m micro sweep`` writes.
 """
 import matplotlib.pyplot as plt
 import numpy as np
@@ -14,8 +16,8 @@ import micro
 
 model = micro.Model(k0=0.1)
 V = [0.1, 0.2, 0.35, 1.0, 2.0, 5.0]
-table = micro.sweep(model, V, numerics=micro.Numerics(eps=0.016))
-table[["V", "regime", "sigma_max", "sigma_min", "sigma_mean", "converged"]]
+table = micro.sweep(model, V)
+table[["V", "method", "regime", "sigma_max", "sigma_min", "discretisation_error", "converged"]]
 
 # %%
 # The extrema against V over the exact steady branch (dotted where unstable): the
@@ -28,6 +30,6 @@ ax.semilogx(branch.V.where(~branch.stable), branch.sigma.where(~branch.stable), 
 ax.semilogx(table.V, table.sigma_max, "o-", label="sigma_max")
 ax.semilogx(table.V, table.sigma_min, "s-", label="sigma_min")
 ax.axvline(micro.critical_velocity(model).Vc, color="grey", lw=0.6)
-ax.set(xlabel="driving velocity V", ylabel="sigma", title="micro sweep, k0 = 0.1, eps = 0.016")
+ax.set(xlabel="driving velocity V", ylabel="sigma", title="micro sweep, k0 = 0.1 (renewal chain and cohort method)")
 ax.legend(fontsize=8)
 fig.tight_layout()

@@ -254,7 +254,8 @@ def test_cohort_falls_back_without_exponential_jumps():
     model = micro.Model(k0=0.3, jumps=micro.Deterministic(0.1))
     res = micro.stationary(model, 0.1, method="cohort", numerics=micro.Numerics(eps=0.025),
                            convergence=micro.Convergence(rtol=5e-2, t_max=40.0), warn=False)
-    assert "cohort method not applicable (jumps are not exponential)" in res.message
+    assert res.method == "fp"
+    assert res.message.startswith("the cohort method needs exponential jumps: Fokker-Planck time-stepping")
 
 
 def test_cohort_rejects_bad_input():
@@ -268,11 +269,12 @@ def test_cohort_rejects_bad_input():
 
 
 def test_cli_sweep_method_cohort(tmp_path, monkeypatch):
-    """``micro sweep --method cohort`` writes the sweep's columns; ``--eps`` is its cell and
-    ``--cohort-dt`` its time step (both reach the method)."""
+    """``micro sweep --method cohort`` writes the sweep's columns; ``--cohort-h`` is its cell
+    and ``--cohort-dt`` its time step (both reach the method); ``--eps``, the
+    Fokker-Planck bin, is refused there before anything is computed."""
     import pandas as pd
 
-    from micro import solver
+    from micro import api
     from micro.cli import main
 
     seen = []
@@ -281,13 +283,16 @@ def test_cli_sweep_method_cohort(tmp_path, monkeypatch):
         seen.append(kw)
         return cycle_cohorts(model, V, **kw)
 
-    monkeypatch.setattr(solver, "cycle_cohorts", spy)
+    monkeypatch.setattr(api, "cycle_cohorts", spy)
+    assert main(["sweep", "--k0", "0.001", "--V", "20", "--method", "cohort", "--eps", "0.01",
+                 "--out", str(tmp_path / "no.csv")]) == 2
+    assert not seen and not (tmp_path / "no.csv").exists()
     out = tmp_path / "cohort.csv"
-    assert main(["sweep", "--k0", "0.001", "--V", "20", "--method", "cohort", "--eps", "0.01", "--cohort-dt", "0.02",
-                 "--out", str(out)]) == 0
+    assert main(["sweep", "--k0", "0.001", "--V", "20", "--method", "cohort", "--cohort-h", "0.01",
+                 "--cohort-dt", "0.02", "--out", str(out)]) == 0
     assert seen and seen[0]["dt"] == 0.02 and seen[0]["h"] == 0.01
     row = pd.read_csv(out).iloc[0]
-    assert row.regime == "stick-slip" and bool(row.converged) and row.eps == 0.01
+    assert row.regime == "stick-slip" and bool(row.converged) and row.eps == 0.01 and row.method == "cohort"
     assert abs(row.sigma_min - micro.sigma_fast_limit(micro.Model(k0=0.001))) < 1e-4
     assert row.sigma_max > row.sigma_mean > row.sigma_min and row.period > 0
 

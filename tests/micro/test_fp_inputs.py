@@ -48,8 +48,23 @@ def test_jump_distributions_reject_bad_parameters(make, match):
         (lambda: micro.Numerics(eps=math.nan), r"eps must be"),
         (lambda: micro.Numerics(theta_shift=1.5), r"theta_shift must be in \(0, 1\]"),
         (lambda: micro.Numerics(theta_relax=0.0), r"theta_relax must be in \(0, 2\]"),
-        (lambda: micro.Numerics(cohort_dt=0.0), r"cohort_dt must be a finite number in \(0, 0.1\]"),
-        (lambda: micro.Numerics(cohort_dt=0.5), r"cohort_dt must be a finite number in \(0, 0.1\]"),
+        (lambda: micro.Cohort(dt=0.0), r"Cohort dt must be a finite number in \(0, 0.1\]"),
+        (lambda: micro.Cohort(dt=0.5), r"Cohort dt must be a finite number in \(0, 0.1\]"),
+        (lambda: micro.Cohort(h=-1.0), r"Cohort h must be a finite number > 0"),
+        (lambda: micro.Cohort(tol=1.0), r"Cohort tol must be in \[1e-09, 0.01\]|Cohort tol must be in \[1e-9, 1e-2\]"),
+        (lambda: micro.Cohort(max_iter=2), r"Cohort max_iter must be an integer >= 4"),
+        (lambda: micro.Renewal(tol=0.5), r"Renewal tol must be in \[1e-13, 1e-3\]"),
+        (lambda: micro.Auto(cohort="x"), r"Auto cohort must be a micro.Cohort"),
+        (lambda: micro.stationary(micro.Model(k0=0.1), 1.0, method="cycle"), r"retired.*method='cohort'"),
+        (lambda: micro.stationary(micro.Model(k0=0.1), 1.0, method="renewal"), r"stationary: method must be one of"),
+        (lambda: micro.stationary(micro.Model(k0=0.1), 1.0, method=micro.Cohort(h=1.0)),
+         r"Cohort h must be in \(0, kappa zbar / 2"),
+        (lambda: micro.stationary(micro.Model(k0=0.1), 1.0, method=micro.FP(eps=0.02),
+                                  numerics=micro.FP(eps=0.01)), r"give the Fokker-Planck options once"),
+        (lambda: micro.simulate(micro.Model(k0=0.1), 1.0, duration=1.0, method="cohort"),
+         r"cohort method does not carry transients"),
+        (lambda: micro.critical_velocity(micro.Model(k0=0.1), method="cohort"),
+         r"critical_velocity: method must be one of"),
         (lambda: micro.Convergence(rtol=0.0), r"rtol must be"),
         (lambda: micro.Convergence(n=1), r"n must be an integer >= 2"),
         (lambda: micro.Convergence(t_max=-1.0), r"t_max must be"),
@@ -132,7 +147,7 @@ def test_every_compiled_kernel_releases_the_gil():
 
     from numba.core.registry import CPUDispatcher
 
-    for name in ("micro._kernels", "micro._nblock_kernels", "micro._renewal_kernels", "rsf._kernels"):
+    for name in ("micro._fp_kernels", "micro._nblock_kernels", "micro._renewal_kernels", "rsf._kernels"):
         module = importlib.import_module(name)
         kernels = [f for f in vars(module).values() if isinstance(f, CPUDispatcher)]
         assert kernels, name

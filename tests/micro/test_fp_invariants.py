@@ -12,7 +12,7 @@ import pytest
 
 import micro
 from micro.grid import Grid
-from micro import solver
+from micro import fp as solver
 from micro.nblock import simulate_nblock
 
 FAST = micro.Numerics(eps=0.016)
@@ -218,7 +218,7 @@ def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state(caplo
 def test_a_persisting_unconverged_oscillation_of_grid_size_is_flagged(drop_in_k0_eps, flagged):
     # A run cut off at t_max with an oscillation that neither grows nor decays is called
     # stick-slip; below 10 k0 eps it must also say that it may be the grid's own.
-    from micro import _kernels as K
+    from micro import _fp_kernels as K
     from micro.analysis import Records, find_cycles
 
     jitter = 1e-3  # k0 * eps

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,9 @@ from scipy.optimize import brentq
 import micro._nblock_kernels as K
 from micro import nblock as nb
 from micro.params import Deterministic, Exponential, Model, Tabulated
+
+sys.path.insert(0, str(Path(__file__).parent))
+from _nblock_reference import hash_uniform_numpy, reference_simulate  # noqa: E402
 
 
 def gamma_pdf(z):
@@ -38,13 +42,13 @@ DISTRIBUTIONS = {
 def test_landscape_hash_kernel_matches_numpy_and_is_uniform():
     blocks = np.arange(20000) % 137
     counts = np.arange(20000) // 137
-    numpy_u = nb.hash_uniform_numpy(12345, blocks, counts)
+    numpy_u = hash_uniform_numpy(12345, blocks, counts)
     kernel_u = np.array([K.hash_uniform(np.uint64(12345), int(b), int(c)) for b, c in zip(blocks[:300], counts[:300])])
     np.testing.assert_array_equal(kernel_u, numpy_u[:300])
     assert np.all((numpy_u > 0.0) & (numpy_u < 1.0))
     assert stats.kstest(numpy_u, "uniform").pvalue > 1e-3
     # different seeds give independent landscapes
-    other = nb.hash_uniform_numpy(12346, blocks, counts)
+    other = hash_uniform_numpy(12346, blocks, counts)
     assert abs(np.corrcoef(numpy_u, other)[0, 1]) < 0.05
 
 
@@ -127,7 +131,7 @@ CASES = [
 def test_event_driven_kernel_matches_bruteforce_reference(name, k0, velocity, t_max):
     model = Model(k0=k0, k1=0.1, k2=0.9, jumps=DISTRIBUTIONS[name])
     n = 24
-    ref = nb.reference_simulate(model, velocity, n, t_max=t_max, seed=3)
+    ref = reference_simulate(model, velocity, n, t_max=t_max, seed=3)
     res = nb.simulate_nblock(model, velocity, n, t_max=t_max, seed=3, record_every=0.01)
     assert res.status == "completed"
     assert res.n_jumps == ref["n_jumps"] > 50
@@ -142,7 +146,7 @@ def test_kernel_matches_reference_through_swaps_and_rebases():
     """Fast relaxation (eta_u = 0.05, gamma = 18) forces many tree swaps and x-rebases."""
     model = Model(k0=0.5, k1=0.1, k2=0.9, eta_u=0.05, jumps=Exponential(0.1))
     velocity, n, t_max = 0.4, 40, 4.0
-    ref = nb.reference_simulate(model, velocity, n, t_max=t_max, seed=11, phases="random")
+    ref = reference_simulate(model, velocity, n, t_max=t_max, seed=11, phases="random")
     res = nb.simulate_nblock(model, velocity, n, t_max=t_max, seed=11, phases="random", record_every=0.5)
     assert res.n_rebases >= 3 and res.n_swaps >= 50
     assert res.n_jumps == ref["n_jumps"]
@@ -155,7 +159,7 @@ def test_kernel_matches_reference_through_swaps_and_rebases():
 @pytest.mark.parametrize("velocity", [1.0, 0.0, [(1.0, 0.5), (2.0, 0.0)]])
 def test_kernel_matches_reference_at_k1_or_k2_zero_and_holds(k1, k2, velocity):
     model = Model(k0=0.3, k1=k1, k2=k2, jumps=Exponential(0.1))
-    ref = nb.reference_simulate(model, velocity, 30, t_max=3.0, seed=2, phases="random")
+    ref = reference_simulate(model, velocity, 30, t_max=3.0, seed=2, phases="random")
     res = nb.simulate_nblock(model, velocity, 30, t_max=3.0, seed=2, phases="random")
     assert res.n_jumps == ref["n_jumps"]
     np.testing.assert_allclose(res.final_state.h, ref["state"].h, atol=1e-11)

@@ -1,10 +1,15 @@
-"""Orchestration of the Fokker-Planck solver: protocol runs, stationary states, the
-critical velocity, sweeps and slide-hold-slide.
+"""The Fokker-Planck method: the equation for P(delta_F, delta_R) at finite driving
+velocity (the paper's Appendix B), time-stepped on the grid of :mod:`micro.grid` by the
+kernels of :mod:`micro._fp_kernels`.
 
-``simulate`` runs a driving protocol and returns the stress time series.
-``stationary`` drives at constant V until the requested quantity has converged (a
-steady stress, or the extrema of a stick-slip cycle) and stops there.
-``critical_velocity`` bisects on the regime, as in the paper's Appendix B.
+The fallback of :mod:`micro`'s question-level API (:mod:`micro.api`): it runs where no
+better method applies (non-exponential jumps), and wherever the density itself is asked
+for (a protocol's transient, a slide-hold-slide, a state to continue).
+``simulate_fp`` runs a driving protocol and returns the stress time series;
+``stationary_fp`` drives at constant V until the requested quantity has converged (a
+steady stress, or the extrema of a stick-slip cycle) and stops there;
+``critical_velocity_fp`` bisects on the regime, as in the paper's Appendix B;
+``slide_hold_slide_fp`` holds and resumes from one steady state.
 """
 from __future__ import annotations
 
@@ -13,214 +18,28 @@ import logging
 import math
 import threading
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Iterator
 
 import numpy as np
 import pandas as pd
 from scipy.stats import linregress
 
-from . import _kernels as K
+from . import _fp_kernels as K
 from .analysis import Records, cycle_converged, find_cycles
 from .analytic import sigma_fast_limit
-from .cohort import cycle_cohorts
-from .cycle import CycleFixedPoint, cycle_fixed_point
 from .grid import Grid, GridSettings
-from .params import KIND_EXPONENTIAL, Model
+from .params import Model
 from .protocols import Drive
-from .renewal import critical_velocity_renewal, steady_sliding
+from .methods import Convergence, Numerics, check_velocity as _check_velocity
+from .results import Critical, Run, Stationary
 
-__all__ = [
-    "Numerics",
-    "Convergence",
-    "Run",
-    "Stationary",
-    "Critical",
-    "default_eps",
-    "simulate",
-    "stationary",
-    "critical_velocity",
-    "sweep",
-    "slide_hold_slide",
-]
+
+__all__ = ["simulate_fp", "stationary_fp", "critical_velocity_fp", "slide_hold_slide_fp"]
 
 log = logging.getLogger(__name__)
 
-#: Default bin: this fraction of a mean jump of delta, kappa * zbar.
-EPS_FRACTION = 1.0 / 50.0
-
-
-def default_eps(model: Model) -> float:
-    """The default bin, ``kappa * zbar / 50`` (2e-3 for the paper's parameters)."""
-    return model.kappa * model.zbar * EPS_FRACTION
-
-
-@dataclass(frozen=True)
-class Numerics:
-    """Discretisation: bin ``eps`` (default :func:`default_eps`), the step limits, the
-    memory the grid may take (``max_memory_gib``; beyond it a run raises
-    :class:`~micro.grid.GridTooLarge` instead of exhausting the machine), and the cohort
-    method's time step ``cohort_dt`` (``method="cohort"``: its ``eps`` is the delta_R cell,
-    default kappa zbar / 20; both are its refinement variables)."""
-
-    eps: float | None = None
-    theta_shift: float = 0.5
-    theta_relax: float = 0.5
-    max_memory_gib: float = 4.0
-    cohort_dt: float = 0.01
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.cohort_dt) and 0.0 < self.cohort_dt <= 0.1):
-            raise ValueError(f"cohort_dt must be a finite number in (0, 0.1], got {self.cohort_dt!r}")
-        if not (math.isfinite(self.max_memory_gib) and self.max_memory_gib > 0.0):
-            raise ValueError(f"max_memory_gib must be a finite number > 0, got {self.max_memory_gib!r}")
-        if self.eps is not None and not (math.isfinite(self.eps) and self.eps > 0.0):
-            raise ValueError(f"eps must be a finite number > 0 (or None for the default), got {self.eps!r}")
-        if not (0.0 < self.theta_shift <= 1.0):
-            raise ValueError(f"theta_shift must be in (0, 1], got {self.theta_shift!r}")
-        if not (0.0 < self.theta_relax <= 2.0):
-            raise ValueError(f"theta_relax must be in (0, 2], got {self.theta_relax!r}")
-
-    def settings(self, model: Model) -> GridSettings:
-        eps = default_eps(model) if self.eps is None else float(self.eps)
-        settings = GridSettings(eps=eps, theta_shift=self.theta_shift, theta_relax=self.theta_relax, dt_max=math.inf,
-                                max_bytes=self.max_memory_gib * 2**30)
-        settings.check(model)
-        return settings
-
-
-@dataclass(frozen=True)
-class Convergence:
-    """When a stationary run stops.
-
-    Parameters
-    ----------
-    rtol : stick-slip: the last ``n`` cycles' sigma_max and sigma_min agree within
-        ``rtol`` times the stress drop and their periods within ``rtol`` (the paper:
-        1 % over three consecutive global shocks).  Steady: the last ``n`` stress means
-        agree within ``rtol`` times the velocity weakening ``|sigma - sigma_inf|``
-        (the paper: 1 % over three values) plus the grid's jitter ``k0 * eps``, plus
-        ``atol``.
-    atol : absolute stress tolerance added to both tests.
-    n : how many consecutive values or cycles must agree.
-    t_max : longest simulated time (None: 400 relaxation times, or 60 times the
-        time the drive needs to load one mean jump, whichever is longer).
-    """
-
-    rtol: float = 1e-2
-    atol: float = 1e-9
-    n: int = 3
-    t_max: float | None = None
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.rtol) and self.rtol > 0.0):
-            raise ValueError(f"rtol must be a finite number > 0, got {self.rtol!r}")
-        if not (math.isfinite(self.atol) and self.atol >= 0.0):
-            raise ValueError(f"atol must be a finite number >= 0, got {self.atol!r}")
-        if int(self.n) != self.n or self.n < 2:
-            raise ValueError(f"n must be an integer >= 2, got {self.n!r}")
-        if self.t_max is not None and not (math.isfinite(self.t_max) and self.t_max > 0.0):
-            raise ValueError(f"t_max must be a finite number > 0 (or None), got {self.t_max!r}")
-
-
-@dataclass
-class Run:
-    """A protocol run: the stress records, the shocks, and the final grid."""
-
-    records: pd.DataFrame
-    shocks: pd.DataFrame
-    grid: Grid
-    wall_time: float
-    mass_error: float = math.nan
-    min_mass: float = math.nan
-
-    def to_frame(self) -> pd.DataFrame:
-        return self.records
-
-
-@dataclass
-class Stationary:
-    """The attractor at constant drive velocity: a steady stress or a stick-slip cycle.
-
-    ``sigma_max``, ``sigma_min`` and ``sigma_mean`` are equal on steady rows;
-    ``sigma_stderr`` is the statistical error of ``sigma_mean`` from the discretisation
-    jitter (the solver is deterministic, but its stress jitters at the scale k0 * eps).
-    ``shocks_per_cycle`` counts the global shocks (cascades of more than 8 bins) per
-    cycle of a stick-slip result.
-    ``converged`` says whether the stopping test was met; ``message`` says why the run
-    ended.  ``mass_error`` (``abs(total probability - 1)``) and ``min_mass`` (the most negative
-    cell mass ever seen, 0 if none) are the solver's own checks of the density.
-    ``records`` holds the stress time series when asked for.  ``sigma_before`` and
-    ``sigma_after`` (``method="cohort"`` only, NaN otherwise) are the stress when a global
-    shock starts and right after it (the paper's sigma_B and sigma_A): ``sigma_max`` is
-    the largest stress of the cycle, above ``sigma_before`` where the creep that precedes
-    a shock outruns the drive (by up to 1e-3 at k0 = 0.3).
-    """
-
-    model: Model
-    V: float
-    eps: float
-    regime: str
-    sigma_max: float
-    sigma_min: float
-    sigma_mean: float
-    period: float
-    converged: bool
-    message: str
-    t_end: float
-    n_cycles: int
-    wall_time: float
-    sigma_stderr: float = math.nan
-    shocks_per_cycle: float = math.nan
-    mass_error: float = math.nan
-    min_mass: float = math.nan
-    sigma_before: float = math.nan
-    sigma_after: float = math.nan
-    records: pd.DataFrame | None = field(default=None, repr=False)
-    shocks: pd.DataFrame | None = field(default=None, repr=False)
-    grid: Grid | None = field(default=None, repr=False)
-    cycle: CycleFixedPoint | None = field(default=None, repr=False)
-
-    def to_dict(self) -> dict:
-        m = self.model
-        return {
-            "k0": m.k0, "k1": m.k1, "k2": m.k2, "zbar": m.zbar, "V": self.V, "regime": self.regime,
-            "sigma_max": self.sigma_max, "sigma_min": self.sigma_min, "sigma_mean": self.sigma_mean,
-            "sigma_before": self.sigma_before, "sigma_after": self.sigma_after, "period": self.period,
-            "sigma_stderr": self.sigma_stderr, "shocks_per_cycle": self.shocks_per_cycle,
-            "converged": self.converged,
-            "message": self.message,
-            "eps": self.eps, "t_end": self.t_end, "n_cycles": self.n_cycles, "wall_time": self.wall_time,
-            "mass_error": self.mass_error, "min_mass": self.min_mass,
-        }
-
-
-@dataclass
-class Critical:
-    """The critical velocity from bisection: ``V_low`` is stick-slip, ``V_high`` steady."""
-
-    model: Model
-    Vc: float
-    V_low: float
-    V_high: float
-    status: str
-    message: str
-    evaluations: list[dict]
-
-    def to_dict(self) -> dict:
-        m = self.model
-        return {"k0": m.k0, "k1": m.k1, "k2": m.k2, "zbar": m.zbar, "Vc": self.Vc, "V_low": self.V_low,
-                "V_high": self.V_high, "status": self.status, "message": self.message}
-
-
 # ------------------------------------------------------------------------------ helpers
-def _check_velocity(V: float, name: str = "V") -> float:
-    V = float(V)
-    if not (math.isfinite(V) and V > 0.0):
-        raise ValueError(f"{name} must be a finite number > 0, got {V!r}")
-    return V
-
-
 def _initial_grid(model: Model, settings: GridSettings, V: float, initial) -> Grid:
     if isinstance(initial, Grid):
         if initial.model != model or initial.settings.eps != settings.eps:
@@ -290,7 +109,7 @@ def _shocks_per_cycle(shock_times: np.ndarray, cycles: pd.DataFrame) -> float:
 
 
 # ------------------------------------------------------------------------------ simulate
-def simulate(
+def simulate_fp(
     model: Model,
     drive: Drive | float,
     *,
@@ -392,67 +211,7 @@ def _drive_position(drive: Drive, t: float) -> float:
 
 
 # ------------------------------------------------------------------------------ stationary
-#: The methods of :func:`stationary` and :func:`sweep`.
-METHODS = ("auto", "fp", "cycle", "cohort")
-#: Default bin of ``method="cycle"``, in units of a mean jump kappa * zbar.
-CYCLE_EPS_FRACTION = 1.0 / 8.0
-
-
-def _cycle(model: Model, V: float, numerics: Numerics, convergence: Convergence, warn: bool,
-           start: CycleFixedPoint | None = None, method: str = "cycle") -> Stationary:
-    """``stationary(method="cycle")`` and ``method="cohort"``: steady rows from the renewal
-    chain, stick-slip rows from the fixed point of the shock-to-shock map
-    (:mod:`micro.cycle`) or from the cohort method (:mod:`micro.cohort`), and the
-    Fokker-Planck time-stepping where they do not apply (shocks that are not total,
-    jumps that are not exponential)."""
-    direct = _direct_steady(model, V)
-    if direct is not None:
-        return direct
-    if method == "cohort":
-        eps = numerics.eps if numerics.eps is not None else model.kappa * model.zbar / 20.0
-    else:
-        eps = numerics.eps if numerics.eps is not None else model.kappa * model.zbar * CYCLE_EPS_FRACTION
-    tol = convergence.rtol * (model.f_th - sigma_fast_limit(model)) + convergence.atol
-    fallback = "jumps are not exponential"
-    if model.jumps.kind == KIND_EXPONENTIAL:
-        if method == "cohort":
-            res = cycle_cohorts(model, V, dt=numerics.cohort_dt, h=eps, tol=tol, start=start)
-        else:
-            res = cycle_fixed_point(model, V, eps, tol=tol, theta_shift=numerics.theta_shift,
-                                    theta_relax=numerics.theta_relax, start=start)
-        if res.applicable:
-            if not res.converged and warn:
-                log.warning("micro.stationary(k0=%g, V=%g, method=%r): %s", model.k0, V, method, res.message)
-            return Stationary(
-                model=model, V=V, eps=eps, regime="stick-slip", sigma_max=res.sigma_max, sigma_min=res.sigma_min,
-                sigma_mean=res.sigma_mean, period=res.period, converged=res.converged, message=res.message,
-                t_end=float(np.nansum(res.history[:, 2])) if res.history is not None else math.nan,
-                n_cycles=res.iterations, wall_time=res.wall_time, sigma_stderr=res.error, shocks_per_cycle=1.0,
-                mass_error=res.mass_error, min_mass=res.min_mass, cycle=res, sigma_before=res.sigma_before,
-                sigma_after=res.sigma_after)
-        fallback = res.message
-    out = stationary(model, V, numerics=replace(numerics, eps=eps), convergence=convergence, warn=warn, method="fp")
-    out.message = f"{method} method not applicable ({fallback}): Fokker-Planck time-stepping; {out.message}"
-    return out
-
-
-def _direct_steady(model: Model, V: float) -> Stationary | None:
-    """The steady state from the renewal chain if steady sliding is stable at V, else None."""
-    start = time.perf_counter()
-    res = steady_sliding(model, V, growth_rate=False)
-    if not bool(res.stable):
-        return None
-    sigma = float(res.sigma)
-    return Stationary(
-        model=model, V=V, eps=math.nan, regime="steady", sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma,
-        period=math.nan, converged=bool(res.converged),
-        message=(f"steady sliding is stable (branching ratio {float(res.branching_ratio):.6g} < 1): "
-                 f"stress from the renewal chain ({int(res.n_nodes)} nodes, error {float(res.sigma_error):.1e})"),
-        t_end=0.0, n_cycles=0, wall_time=time.perf_counter() - start, sigma_stderr=float(res.sigma_error),
-        shocks_per_cycle=0.0, mass_error=0.0, min_mass=0.0)
-
-
-def stationary(
+def stationary_fp(
     model: Model,
     V: float,
     *,
@@ -462,39 +221,9 @@ def stationary(
     keep_records: bool = False,
     keep_grid: bool = False,
     warn: bool = True,
-    method: str = "auto",
 ) -> Stationary:
-    """The attractor at constant drive velocity ``V``: a steady stress or a stick-slip cycle.
-
-    ``method="cycle"``: where steady sliding is unstable, the stick-slip cycle is the
-    fixed point of its shock-to-shock return map (:func:`micro.cycle.cycle_fixed_point`):
-    the state after a total global shock is Exp(kappa zbar) in delta times the marginal
-    of delta_R, the Fokker-Planck grid carries it through one loading phase, and the
-    shock is solved in closed form, so no shock is time-stepped and the cost per cycle
-    does not grow as k0 falls (k0 = 1e-3 and 1e-4 cost what k0 = 0.01 does).  It stops
-    when ``n = 10`` cycles show no drift and their mean is known to ``rtol * (f_th -
-    sigma_fast_limit(model)) + atol`` (``sigma_stderr`` holds that error; 1e-3 with the
-    defaults); the default bin is ``kappa * zbar / 8``.  Where shocks are not total (large
-    k0, or close to V^c) or jumps are not exponential, it falls back to time-stepping
-    and says so in ``message``.  ``result.cycle`` holds the fixed point; passing it as
-    ``initial`` at a nearby V starts the map there (fewer cycles).
-
-    ``method="cohort"``: the same rows from the cohort method
-    (:func:`micro.cohort.cycle_cohorts`), which keeps no grid in the margin: the blocks
-    born in one step are Exp(kappa zbar) in their margin at birth times a density in
-    delta_R, every crossed mass is an exact integral, and where a shock starts is a
-    continuous function of the state, so the cycles converge smoothly and are
-    extrapolated (``eps`` is its delta_R cell, default ``kappa * zbar / 20``; time step
-    0.01).  Shocks need not be total; it falls back to time-stepping only where jumps
-    are not exponential or no shock ends a loading phase.  Continuation as with
-    ``"cycle"``.
-
-    ``method="auto"`` (the default) asks the renewal chain first
-    (:func:`micro.steady_sliding`): where steady sliding is stable its stress is exact
-    (to ~1e-11, in milliseconds) and no time-stepping is done; elsewhere, and whenever
-    the Fokker-Planck state is wanted (``keep_grid``, ``keep_records`` or an ``initial``
-    grid), the Fokker-Planck equation is time-stepped as with ``method="fp"``, which
-    always time-steps.
+    """The attractor at constant drive velocity ``V`` by time-stepping the Fokker-Planck
+    equation (``micro.stationary(method="fp")``): a steady stress or a stick-slip cycle.
 
     Time-stepping drives at constant ``V`` until the attractor's stress has converged,
     and stops there.
@@ -509,22 +238,9 @@ def stationary(
     :func:`critical_velocity`); ``converged`` and ``message`` say it either way.
     """
     V = _check_velocity(V)
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {', '.join(repr(m) for m in METHODS)}, got {method!r}")
     numerics = numerics or Numerics()
     convergence = convergence or Convergence()
-    if method in ("cycle", "cohort"):
-        if not (isinstance(initial, CycleFixedPoint) or (isinstance(initial, str) and initial == "auto")):
-            raise ValueError(f"with method={method!r}, initial must be 'auto' or a previous result's .cycle "
-                             f"(a micro.cycle.CycleFixedPoint), got {type(initial).__name__}")
-        return _cycle(model, V, numerics, convergence, warn,
-                      start=initial if isinstance(initial, CycleFixedPoint) else None, method=method)
     settings = numerics.settings(model)
-    wants_fp_state = keep_grid or keep_records or not (isinstance(initial, str) and initial == "auto")
-    if method == "auto" and not wants_fp_state:
-        direct = _direct_steady(model, V)
-        if direct is not None:
-            return direct
     grid = _initial_grid(model, settings, V, initial)
     start = time.perf_counter()
 
@@ -608,7 +324,7 @@ def stationary(
     result = Stationary(
         model=model, V=V, eps=settings.eps, regime=regime, converged=converged, message=message,
         t_end=grid.t - t_begin, n_cycles=int(len(find_cycles(rec, hysteresis))),
-        wall_time=time.perf_counter() - start, **out, **_density_checks(grid),
+        wall_time=time.perf_counter() - start, **out, **_density_checks(grid), method="fp",
     )
     if keep_records:
         result.records = rec.to_frame()
@@ -759,31 +475,22 @@ def _cycle_amplitude(res: Stationary) -> float:
     return float(np.median(cycles.sigma_max - cycles.sigma_min))
 
 
-def critical_velocity(
+def critical_velocity_fp(
     model: Model,
     *,
-    V_min: float = 1e-4,
-    V_max: float | None = None,
+    V_min: float,
+    V_max: float,
     V_guess: float = 1.0,
     factor: float = 8.0,
     rel_tol: float = 1e-2,
     numerics: Numerics | None = None,
     convergence: Convergence | None = None,
     refine: bool = True,
-    method: str = "renewal",
 ) -> Critical:
-    """Critical velocity V^c: where steady sliding loses stability.
-
-    ``method="renewal"`` (the default) solves it directly: V^c is the root of
-    ``b(V) = 1``, the branching ratio of steady sliding from the renewal chain
-    (:func:`micro.steady_sliding`; derivation in docs/reference/micro_renewal.md), to ~1e-10
-    relative in a fraction of a second.  ``V_min`` and ``V_max`` (default 1e7 here, 1e3
-    for the bisection) bound the search; the other options belong to ``method="fp"``.
-    ``k0 >= k2``: Vc = 0 at once (steady sliding is stable at every V).  ``V_low`` and
-    ``V_high`` are ``Vc`` minus and plus its error estimate.
-
-    ``method="fp"``: bisection on the regime of Fokker-Planck runs (the paper's
-    Appendix B), kept for cross-checks.
+    """Critical velocity V^c by bisection on the regime of Fokker-Planck runs (the paper's
+    Appendix B; ``micro.critical_velocity(method="fp")``), kept for cross-checks: the
+    default, the renewal chain's root of b(V) = 1, is exact.  The arguments are checked
+    by :func:`micro.critical_velocity`.
 
     The regime is evaluated at ``V_guess``, then at velocities ``factor`` times smaller
     or larger (within ``[V_min, V_max]``) until it changes; the bracket is then halved
@@ -820,24 +527,6 @@ def critical_velocity(
     ``amplitude_fine`` at eps / 2 and the ``wall_time_fine`` of the runs at eps / 2 it
     took (NaN otherwise; ``amplitude`` is NaN without ``refine``).
     """
-    if method not in ("renewal", "fp"):
-        raise ValueError(f"method must be 'renewal' or 'fp', got {method!r}")
-    V_min = _check_velocity(V_min, "V_min")
-    V_max = _check_velocity((1e7 if method == "renewal" else 1e3) if V_max is None else V_max, "V_max")
-    if not V_max > V_min:
-        raise ValueError(f"V_max must be > V_min, got V_min={V_min!r}, V_max={V_max!r}")
-    V_guess = _check_velocity(V_guess, "V_guess")
-    if not (math.isfinite(factor) and factor > 1.0):
-        raise ValueError(f"factor must be a finite number > 1, got {factor!r}")
-    if not (math.isfinite(rel_tol) and 0.0 < rel_tol < 1.0):
-        raise ValueError(f"rel_tol must be in (0, 1), got {rel_tol!r}")
-    if method == "renewal":
-        Vc, error, status, message, evaluations = critical_velocity_renewal(model, V_min=V_min, V_max=V_max)
-        low, high = (Vc - error, Vc + error) if math.isfinite(Vc) and Vc > 0.0 else (
-            (0.0, V_min) if Vc == 0.0 else (V_max, math.inf))
-        if status != "converged":
-            log.info("micro.critical_velocity(k0=%g, k1=%g, k2=%g): %s", model.k0, model.k1, model.k2, message)
-        return Critical(model, Vc, low, high, status, message, evaluations)
     if model.k2 == 0.0 or model.k0 >= model.k2:
         # closed form: steady sliding is stable at every V, nothing to bisect
         return _reported(Critical(model, 0.0, 0.0, V_min, "no stick-slip",
@@ -856,7 +545,7 @@ def critical_velocity(
     def run(V: float, conv: Convergence, num: Numerics, chain: dict) -> tuple[Stationary, float]:
         """A run at V, from the chain's steady state if it is faster than V."""
         started_from = chain["V"] if V < chain["V"] and chain["grid"] is not None else math.nan
-        res = stationary(model, V, numerics=num, convergence=conv, keep_grid=True, keep_records=refine,
+        res = stationary_fp(model, V, numerics=num, convergence=conv, keep_grid=True, keep_records=refine,
                          initial=chain["grid"] if math.isfinite(started_from) else "auto", warn=False)
         return res, started_from
 
@@ -936,6 +625,7 @@ def _reported(crit: Critical) -> Critical:
     """``crit``, after one warning for the bisection's runs that missed their stopping
     test (near V^c most do: the damping vanishes there).  The runs themselves do not
     warn; each is logged at INFO and recorded in ``crit.evaluations``."""
+    crit.method = "fp"
     missed = [e for e in crit.evaluations if not e["converged"]]
     if missed:
         log.warning("micro.critical_velocity(k0=%g, k1=%g, k2=%g): %s (%s); %d of %d runs did not converge by "
@@ -945,53 +635,8 @@ def _reported(crit: Critical) -> Critical:
     return crit
 
 
-# ------------------------------------------------------------------------------ sweep
-def sweep(
-    model: Model,
-    velocities,
-    *,
-    numerics: Numerics | None = None,
-    convergence: Convergence | None = None,
-    continuation: bool = True,
-    method: str = "auto",
-) -> pd.DataFrame:
-    """Stationary states for each velocity, one row each.
-
-    With ``method="auto"`` a velocity where steady sliding is stable takes its row from
-    the renewal chain (no time-stepping); the others are Fokker-Planck runs
-    (``method="fp"``: all of them).  ``method="cycle"``: stick-slip rows from the
-    return map's fixed point (see :func:`stationary`), each started, with
-    ``continuation``, from the previous row's (10-15 cycles instead of 20-35).  With ``continuation`` every Fokker-Planck run starts
-    from the previous run's final density (points are visited in the given order),
-    which shortens transients.
-    """
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {', '.join(repr(m) for m in METHODS)}, got {method!r}")
-    velocities = [_check_velocity(V) for V in velocities]
-    rows = []
-    grid = None
-    start = None
-    for V in velocities:
-        if method in ("cycle", "cohort"):
-            res = stationary(model, V, numerics=numerics, convergence=convergence, method=method,
-                             initial=start if (continuation and start is not None) else "auto")
-            start = res.cycle if res.cycle is not None and res.cycle.applicable else start
-            rows.append(res.to_dict())
-            continue
-        direct = _direct_steady(model, V) if method == "auto" else None
-        if direct is not None:
-            rows.append(direct.to_dict())
-            continue
-        res = stationary(model, V, numerics=numerics, convergence=convergence, method="fp",
-                         initial=grid if (continuation and grid is not None) else "auto", keep_grid=continuation)
-        grid = res.grid
-        res.grid = None
-        rows.append(res.to_dict())
-    return pd.DataFrame(rows)
-
-
 # ------------------------------------------------------------------------------ slide-hold-slide
-def slide_hold_slide(
+def slide_hold_slide_fp(
     model: Model,
     V: float,
     hold_times,
@@ -1013,7 +658,7 @@ def slide_hold_slide(
     for h in holds:
         if not (math.isfinite(h) and h >= 0.0):
             raise ValueError(f"hold times must be finite numbers >= 0, got {h!r}")
-    base = stationary(model, V, numerics=numerics, convergence=convergence, keep_grid=True, method="fp")
+    base = stationary_fp(model, V, numerics=numerics, convergence=convergence, keep_grid=True)
     if base.regime != "steady":
         raise ValueError(f"slide-hold-slide needs steady sliding at V = {V:g}; the attractor is {base.regime}")
     tau_u, tau_c, _ = _time_scales(model, V)
@@ -1030,5 +675,5 @@ def slide_hold_slide(
         r, _, _ = grid.advance(V, grid.t + resume, record_dsigma=resolution / 4.0, record_dt=resume / 400.0)
         peak = float(max(r[:, 3].max(), r[:, 1].max())) if len(r) else math.nan
         rows.append({"hold_time": h, "sigma_steady": base.sigma_mean, "sigma_peak": peak,
-                     "delta_sigma_max": peak - base.sigma_mean})
+                     "delta_sigma_max": peak - base.sigma_mean, "method": "fp"})
     return pd.DataFrame(rows)

@@ -1,0 +1,425 @@
+"""The question-level API of :mod:`micro`: one call per question, each dispatching to the
+best method for it through one table, as ``scipy.integrate.solve_ivp`` dispatches to its
+methods.
+
+=====================  ==========================================================
+question               methods (``"auto"``, the default, first)
+=====================  ==========================================================
+:func:`stationary`     auto: renewal chain where steady sliding is stable, cohort
+                       method for stick-slip (exponential jumps), Fokker-Planck
+                       where neither applies or its state is asked for;
+                       ``"cohort"``, ``"fp"``
+:func:`sweep`          as :func:`stationary`, one row per velocity, continued
+:func:`critical_velocity`  auto = ``"renewal"`` (exact); ``"fp"`` (bisection)
+:func:`simulate`       auto = ``"fp"`` (the only method that carries a transient)
+:func:`slide_hold_slide`  auto = ``"fp"``
+=====================  ==========================================================
+
+``method=`` takes a name or an options object (:mod:`micro.methods`); every result
+says which method produced it (``method``), and each row says what its error covers.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import time
+from functools import lru_cache
+
+import numpy as np
+import pandas as pd
+
+from . import fp
+from .cohort import cycle_cohorts
+from .methods import FP, Auto, Cohort, Convergence, Method, Renewal, check_velocity, resolve
+from .params import KIND_EXPONENTIAL, Model
+from .protocols import Drive
+from .renewal import critical_velocity_renewal, steady_sliding
+from .results import Critical, CycleFixedPoint, Run, Stationary
+
+__all__ = ["stationary", "sweep", "critical_velocity", "simulate", "slide_hold_slide"]
+
+log = logging.getLogger(__name__)
+
+#: Closer to V^c than this (d = (V^c - V) / V^c) the change of a cohort cycle from twice
+#: the step and cell is not known to bound its error: at k0 = 0.01 the cell refinement is
+#: not monotone at d ~ 0.01 (kappa zbar / 20, /40, /80 move sigma_max by -9e-5, then
+#: +6.6e-4), and the cycle differs from an N-block at N = 1e6 by more than three
+#: standard errors at d = 0.1 and 0.05.  Such rows report ``discretisation_error = NaN``
+#: (not known) until the transition study settles the method there.
+NEAR_VC = 0.2
+
+
+def _check_model(model) -> Model:
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be a micro.Model, got {type(model).__name__}")
+    return model
+
+
+def _check_numerics(numerics, method: Method) -> FP | None:
+    """The Fokker-Planck options: ``numerics``, or ``method`` given as a :class:`FP`
+    object (not both), or None (its defaults)."""
+    given = method if isinstance(method, FP) else None
+    if numerics is None:
+        return given
+    if not isinstance(numerics, FP):
+        raise ValueError(f"numerics must be a micro.FP (micro.Numerics), got {type(numerics).__name__}")
+    if given is not None and given != numerics:
+        raise ValueError("give the Fokker-Planck options once: as method=micro.FP(...) or as numerics=, not both")
+    return numerics
+
+
+@lru_cache(maxsize=64)
+def _vc(model: Model) -> float:
+    """V^c from the renewal chain (cached per model: it serves every row of a sweep)."""
+    return float(critical_velocity_renewal(model)[0])
+
+
+# ------------------------------------------------------------------------------ stationary
+def _renewal_row(model: Model, V: float, opts: Renewal) -> Stationary | None:
+    """The steady state from the renewal chain if steady sliding is stable at V, else None."""
+    start = time.perf_counter()
+    res = steady_sliding(model, V, tol=opts.tol, growth_rate=False)
+    if not bool(res.stable):
+        return None
+    sigma = float(res.sigma)
+    error = float(res.sigma_error)
+    return Stationary(
+        model=model, V=V, eps=math.nan, regime="steady", sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma,
+        period=math.nan, converged=bool(res.converged),
+        message=(f"steady sliding is stable (branching ratio {float(res.branching_ratio):.6g} < 1): "
+                 f"stress from the renewal chain ({int(res.n_nodes)} nodes, error {error:.1e})"),
+        t_end=0.0, n_cycles=0, wall_time=time.perf_counter() - start, sigma_stderr=error,
+        shocks_per_cycle=0.0, mass_error=0.0, min_mass=0.0, method="renewal", discretisation_error=error)
+
+
+def _cohort_row(model: Model, V: float, opts: Cohort, warn: bool,
+                start: CycleFixedPoint | None) -> Stationary | None:
+    """The stick-slip cycle by the cohort method, or None where it does not apply."""
+    h = opts.cell(model)
+    res = cycle_cohorts(model, V, dt=opts.dt, h=h, tol=opts.tol, max_iter=opts.max_iter, start=start)
+    if not res.applicable:
+        return None
+    d = 1.0 - V / _vc(model)
+    if res.coarse is not None and d >= NEAR_VC:
+        # the change of the cycle from twice the step and cell, plus what the two fixed points
+        # may still be off (a bound on the coarse cycle's discretisation error, so on this one's)
+        change = max(abs(res.sigma_max - res.coarse.sigma_max), abs(res.sigma_min - res.coarse.sigma_min))
+        disc = change + res.coarse.error + res.error
+        covers = (f"; discretisation error at most {disc:.1e} (the change {change:.1e} from dt = {2 * opts.dt:g}, "
+                  f"h = {2 * h:.3g}, plus both fixed points' errors); fixed-point error {res.error:.1e}")
+    else:
+        disc = math.nan
+        why = (f"d = (V^c - V)/V^c = {d:.3g} < {NEAR_VC:g}, where the cell refinement is not known to converge"
+               if d < NEAR_VC else "no run at twice the step and cell to compare with")
+        covers = f"; discretisation error not known ({why}); the fixed-point error {res.error:.1e} covers the iteration only"
+    if not res.converged and warn:
+        log.warning("micro.stationary(k0=%g, V=%g, method='cohort'): %s", model.k0, V, res.message)
+    return Stationary(
+        model=model, V=V, eps=h, regime="stick-slip", sigma_max=res.sigma_max, sigma_min=res.sigma_min,
+        sigma_mean=res.sigma_mean, period=res.period, converged=res.converged, message=res.message + covers,
+        t_end=float(np.nansum(res.history[:, 2])) if res.history is not None else math.nan,
+        n_cycles=res.iterations, wall_time=res.wall_time, sigma_stderr=res.error, shocks_per_cycle=1.0,
+        mass_error=res.mass_error, min_mass=res.min_mass, cycle=res, sigma_before=res.sigma_before,
+        sigma_after=res.sigma_after, method="cohort", discretisation_error=disc)
+
+
+def _fp_row(model: Model, V: float, numerics: FP | None, convergence: Convergence, warn: bool, initial="auto",
+            keep_records: bool = False, keep_grid: bool = False, why: str = "") -> Stationary:
+    out = fp.stationary_fp(model, V, numerics=numerics, convergence=convergence, initial=initial,
+                           keep_records=keep_records, keep_grid=keep_grid, warn=warn)
+    if why:
+        out.message = f"{why}: Fokker-Planck time-stepping; {out.message}"
+    return out
+
+
+def _direct_then_cycle(model: Model, V: float, opts: Auto, numerics: FP | None, convergence: Convergence,
+                       warn: bool, start: CycleFixedPoint | None) -> Stationary:
+    """The best answer at V without the Fokker-Planck state: renewal if steady sliding
+    is stable, else the cohort cycle, else (non-exponential jumps, or a loading phase
+    that ends in no shock) the Fokker-Planck equation."""
+    direct = _renewal_row(model, V, opts.renewal)
+    if direct is not None:
+        return direct
+    if model.jumps.kind != KIND_EXPONENTIAL:
+        return _fp_row(model, V, numerics, convergence, warn,
+                       why="the cohort method needs exponential jumps")
+    row = _cohort_row(model, V, opts.cohort, warn, start)
+    if row is not None:
+        return row
+    return _fp_row(model, V, numerics, convergence, warn, why="the cohort method does not apply (no shock ends "
+                                                               "the loading phase)")
+
+
+def stationary(
+    model: Model,
+    V: float,
+    *,
+    method: Method = "auto",
+    numerics: FP | None = None,
+    convergence: Convergence | None = None,
+    initial="auto",
+    keep_records: bool = False,
+    keep_grid: bool = False,
+    warn: bool = True,
+) -> Stationary:
+    """The attractor at constant drive velocity ``V``: a steady stress or a stick-slip cycle.
+
+    Parameters
+    ----------
+    model : the model.
+    V : drive velocity, > 0.
+    method : ``"auto"`` (default), ``"cohort"``, ``"fp"``, or an options object
+        (:class:`micro.Auto`, :class:`micro.Cohort`, :class:`micro.FP`).
+
+        * ``"auto"``: where steady sliding is stable, its stress from the renewal chain
+          (exact to ~1e-11, milliseconds); elsewhere the stick-slip cycle by the cohort
+          method (:func:`micro.cohort.cycle_cohorts`: the fixed point of the cycle map,
+          seconds at every k0); the Fokker-Planck equation only where the cohort method
+          does not apply (non-exponential jumps), or when its state is asked for
+          (``keep_grid``, ``keep_records`` or an ``initial`` grid).
+        * ``"cohort"``: as ``"auto"`` without the Fokker-Planck state.
+        * ``"fp"``: always time-steps the Fokker-Planck equation (bin ``numerics.eps``).
+    numerics : the Fokker-Planck options (:class:`micro.FP`), wherever it runs.
+    convergence : the Fokker-Planck runs' stopping rule (:class:`micro.Convergence`); the
+        cohort's fixed point is solved to its own ``Cohort.tol``.
+    initial : ``"auto"``; a previous result's ``.cycle`` (cohort: continue from it); or a
+        Fokker-Planck ``Grid`` or start name (``"frozen"``, ``"relaxed"``, ``"uniform"``).
+    keep_records, keep_grid : keep the Fokker-Planck run's stress records or final grid.
+    warn : log a warning for a result that did not converge.
+
+    Returns
+    -------
+    Stationary
+        ``method`` says which method produced it; ``discretisation_error`` what its
+        discretisation may have moved (NaN where not known), ``sigma_stderr`` the
+        iteration's own error.
+
+    Raises
+    ------
+    ValueError
+        For a bad argument or a method that does not answer this question (``"cycle"``
+        is retired: use ``"cohort"``), before anything is computed.
+    """
+    _check_model(model)
+    V = check_velocity(V)
+    opts = resolve(method, ("auto", "cohort", "fp"), "stationary")
+    numerics = _check_numerics(numerics, method)
+    if numerics is not None:
+        numerics.settings(model)  # (a bin out of range fails now)
+    convergence = convergence or Convergence()
+    if not isinstance(convergence, Convergence):
+        raise ValueError(f"convergence must be a micro.Convergence, got {type(convergence).__name__}")
+    cycle_start = initial if isinstance(initial, CycleFixedPoint) else None
+    fp_state = keep_grid or keep_records or not (cycle_start is not None
+                                                 or (isinstance(initial, str) and initial == "auto"))
+    if isinstance(opts, FP):
+        if cycle_start is not None:
+            raise ValueError("initial: a cohort cycle cannot start a Fokker-Planck run; give a Grid or 'auto'")
+        return _fp_row(model, V, numerics, convergence, warn, initial, keep_records, keep_grid)
+    if isinstance(opts, Cohort):
+        if fp_state:
+            raise ValueError("keep_grid, keep_records and an initial grid belong to method='fp' (or 'auto'); "
+                             "method='cohort' keeps no grid")
+        opts = Auto(cohort=opts)
+    elif fp_state:
+        if cycle_start is not None:
+            raise ValueError("initial: a cohort cycle cannot start a Fokker-Planck run; give a Grid or 'auto'")
+        return _fp_row(model, V, numerics, convergence, warn, initial, keep_records, keep_grid)
+    opts.cohort.cell(model)  # (a cell out of range fails now)
+    return _direct_then_cycle(model, V, opts, numerics, convergence, warn, cycle_start)
+
+
+# ------------------------------------------------------------------------------ sweep
+def sweep(
+    model: Model,
+    velocities,
+    *,
+    method: Method = "auto",
+    numerics: FP | None = None,
+    convergence: Convergence | None = None,
+    continuation: bool = True,
+    on_row=None,
+) -> pd.DataFrame:
+    """Stationary states for each velocity, one row each (:func:`stationary`).
+
+    Parameters
+    ----------
+    model : the model.
+    velocities : drive velocities, each > 0, visited in the given order.
+    method, numerics, convergence : as in :func:`stationary`.
+    continuation : start each Fokker-Planck row from the previous row's final density,
+        which shortens transients.  Cohort rows always start from their own run at twice
+        the step and cell (an eighth of the cost), whose change is the row's
+        ``discretisation_error``.
+    on_row : called with the frame of the rows so far after each row (a CLI writes it,
+        so that nothing computed is lost if a later row fails).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per velocity (:meth:`Stationary.to_dict`), with a ``method`` column.
+    """
+    _check_model(model)
+    opts = resolve(method, ("auto", "cohort", "fp"), "sweep")
+    numerics = _check_numerics(numerics, method)
+    velocities = [check_velocity(V) for V in np.atleast_1d(velocities).tolist()]
+    if numerics is not None:
+        numerics.settings(model)
+    if isinstance(opts, (Auto, Cohort)):
+        (opts.cohort if isinstance(opts, Auto) else opts).cell(model)
+    rows: list[dict] = []
+    seed_grid = None
+    for V in velocities:
+        if isinstance(opts, FP):
+            res = stationary(model, V, method="fp", numerics=numerics, convergence=convergence,
+                             initial=seed_grid if (continuation and seed_grid is not None) else "auto",
+                             keep_grid=continuation)
+            seed_grid, res.grid = res.grid, None
+        else:
+            res = stationary(model, V, method=opts, numerics=numerics, convergence=convergence)
+        rows.append(res.to_dict())
+        if on_row is not None:
+            on_row(pd.DataFrame(rows))
+    return pd.DataFrame(rows)
+
+
+# ------------------------------------------------------------------------------ critical velocity
+def critical_velocity(
+    model: Model,
+    *,
+    method: Method = "auto",
+    V_min: float = 1e-4,
+    V_max: float | None = None,
+    V_guess: float = 1.0,
+    factor: float = 8.0,
+    rel_tol: float = 1e-2,
+    numerics: FP | None = None,
+    convergence: Convergence | None = None,
+    refine: bool = True,
+) -> Critical:
+    """Critical velocity V^c: where steady sliding loses stability.
+
+    Parameters
+    ----------
+    model : the model.
+    method : ``"auto"`` = ``"renewal"`` (the default): V^c is the root of ``b(V) = 1``,
+        the branching ratio of steady sliding from the renewal chain (derivation in
+        docs/reference/micro_renewal.md), to ~1e-10 relative in a fraction of a second;
+        ``V_low`` and ``V_high`` are ``Vc`` minus and plus its error estimate.
+        ``"fp"``: bisection on the regime of Fokker-Planck runs (the paper's Appendix B;
+        minutes, uncertain by the bin; :func:`micro.fp.critical_velocity_fp`), kept for
+        cross-checks; ``V_guess``, ``factor``, ``rel_tol``, ``numerics``, ``convergence``
+        and ``refine`` are its options.
+    V_min, V_max : the search range (``V_max`` default 1e7 for the renewal chain, 1e3 for
+        the bisection).
+
+    Returns
+    -------
+    Critical
+        ``Vc = 0`` with status ``"no stick-slip"`` where steady sliding is stable at every
+        V (``k0 >= k2``); ``inf`` with ``"above range"`` beyond ``V_max``.
+    """
+    _check_model(model)
+    opts = resolve(method, ("auto", "renewal", "fp"), "critical_velocity")
+    numerics = _check_numerics(numerics, method)
+    bisect = isinstance(opts, FP)
+    V_min = check_velocity(V_min, "V_min")
+    V_max = check_velocity((1e3 if bisect else 1e7) if V_max is None else V_max, "V_max")
+    if not V_max > V_min:
+        raise ValueError(f"V_max must be > V_min, got V_min={V_min:g}, V_max={V_max:g}")
+    V_guess = check_velocity(V_guess, "V_guess")
+    if not (math.isfinite(factor) and factor > 1.0):
+        raise ValueError(f"factor must be a finite number > 1, got {factor!r}")
+    if not (math.isfinite(rel_tol) and 0.0 < rel_tol < 1.0):
+        raise ValueError(f"rel_tol must be in (0, 1), got {rel_tol!r}")
+    if bisect:
+        if numerics is not None:
+            numerics.settings(model)
+        return fp.critical_velocity_fp(model, V_min=V_min, V_max=V_max, V_guess=V_guess, factor=factor,
+                                       rel_tol=rel_tol, numerics=numerics, convergence=convergence, refine=refine)
+    renewal = opts.renewal if isinstance(opts, Auto) else opts
+    Vc, error, status, message, evaluations = critical_velocity_renewal(model, V_min=V_min, V_max=V_max,
+                                                                         tol=renewal.tol)
+    low, high = (Vc - error, Vc + error) if math.isfinite(Vc) and Vc > 0.0 else (
+        (0.0, V_min) if Vc == 0.0 else (V_max, math.inf))
+    if status != "converged":
+        log.info("micro.critical_velocity(k0=%g, k1=%g, k2=%g): %s", model.k0, model.k1, model.k2, message)
+    return Critical(model, Vc, low, high, status, message, evaluations, method="renewal")
+
+
+# ------------------------------------------------------------------------------ transients
+def _transient_method(method: Method, numerics, question: str) -> FP | None:
+    opts = resolve(method, ("auto", "fp", "cohort"), question)
+    if isinstance(opts, Cohort):
+        raise ValueError(f"{question}: the cohort method does not carry transients (it solves cycles as fixed "
+                         "points of the cycle map); use method='auto' or 'fp'")
+    return _check_numerics(numerics, method)
+
+
+def simulate(
+    model: Model,
+    drive: Drive | float,
+    *,
+    method: Method = "auto",
+    duration: float | None = None,
+    numerics: FP | None = None,
+    initial="auto",
+    record_dsigma: float | None = None,
+    record_dt: float | None = None,
+    progress: bool = False,
+) -> Run:
+    """Run a driving protocol and return the stress time series.
+
+    ``method="auto"`` is the Fokker-Planck equation (:func:`micro.fp.simulate_fp`), the
+    method that carries a transient under any :class:`~micro.Drive`; its options go in
+    ``numerics`` (or ``method=micro.FP(...)``).
+
+    Parameters
+    ----------
+    model : the model.
+    drive : a :class:`~micro.Drive`, or a constant velocity (then ``duration`` is required).
+    method : ``"auto"`` or ``"fp"`` (or :class:`micro.FP`).
+    duration : run length for a constant velocity.
+    numerics : the Fokker-Planck options.
+    initial : ``"auto"``, ``"frozen"``, ``"relaxed"``, ``"uniform"`` or a Grid to start from.
+    record_dsigma, record_dt : record the stress whenever it moved by ``record_dsigma``
+        and at least every ``record_dt``.
+    progress : a progress bar of the simulated time on stderr.
+
+    Returns
+    -------
+    Run
+        ``records``: columns ``t, w, sigma, sigma_min, sigma_max, sigma_mean``.
+    """
+    _check_model(model)
+    numerics = _transient_method(method, numerics, "simulate")
+    return fp.simulate_fp(model, drive, duration=duration, numerics=numerics, initial=initial,
+                          record_dsigma=record_dsigma, record_dt=record_dt, progress=progress)
+
+
+def slide_hold_slide(
+    model: Model,
+    V: float,
+    hold_times,
+    *,
+    method: Method = "auto",
+    numerics: FP | None = None,
+    convergence: Convergence | None = None,
+    resume: float | None = None,
+) -> pd.DataFrame:
+    """Stress peak after a hold, for each hold time (the paper's Fig. 7).
+
+    Drives at ``V`` until stationary (steady sliding is required), then for each hold
+    time stops the drive for ``hold``, resumes at ``V`` for ``resume`` (default: 20 cycle
+    times plus 2 relaxation times) and records the largest stress after resuming, by the
+    Fokker-Planck equation (``method="auto"`` or ``"fp"``: the cohort method does not
+    carry transients).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``hold_time, sigma_steady, sigma_peak, delta_sigma_max, method`` per hold.
+    """
+    _check_model(model)
+    numerics = _transient_method(method, numerics, "slide_hold_slide")
+    return fp.slide_hold_slide_fp(model, V, hold_times, numerics=numerics, convergence=convergence, resume=resume)

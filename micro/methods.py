@@ -1,0 +1,254 @@
+"""How each method of :mod:`micro` is set: one small frozen, validated options object per
+method, and the table that names them.
+
+Each question of :mod:`micro.api` takes ``method=``, a name (the method with its
+defaults) or one of these objects, in the spirit of ``scipy.integrate.solve_ivp``'s
+per-method arguments and of diffrax's solver objects:
+
+* :class:`Renewal`: steady sliding, its spectrum and V^c by the jump-to-jump renewal
+  chain (:mod:`micro.renewal`); its tolerance.
+* :class:`Cohort`: stick-slip cycles by cohorts of exponential margins
+  (:mod:`micro.cohort`); its time step and delta_R cell.
+* :class:`FP`: the Fokker-Planck equation (:mod:`micro.fp`); its bin (also
+  ``numerics=``, its older name :class:`Numerics`).
+* :class:`Auto` (``"auto"``, the default): the best method for each question, each
+  with the options given here.
+
+:class:`Convergence`, the stopping rule of the iterations, is shared.  A method that is
+retired (``"cycle"``) or unknown fails here, in one line, before anything is computed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar, Union
+
+from .grid import GridSettings
+from .params import Model
+
+__all__ = ["FP", "Numerics", "Cohort", "Renewal", "Auto", "Convergence", "METHODS", "resolve", "default_eps",
+           "check_velocity"]
+
+
+def _no_bool(obj, names) -> None:
+    """Numbers only: a bool (``True`` is an int to Python) is refused, naming the field."""
+    for name in names:
+        if isinstance(getattr(obj, name), bool):
+            raise ValueError(f"{name} must be a number, got {getattr(obj, name)!r}")
+
+
+def check_velocity(V: float, name: str = "V") -> float:
+    """``V`` as a finite float > 0, or one ValueError naming it."""
+    if isinstance(V, bool) or not isinstance(V, (int, float)) and not hasattr(V, "__float__"):
+        raise ValueError(f"{name} must be a number > 0, got {V!r}")
+    V = float(V)
+    if not (math.isfinite(V) and V > 0.0):
+        raise ValueError(f"{name} must be a finite number > 0, got {V:g}")
+    return V
+
+
+#: Default bin: this fraction of a mean jump of delta, kappa * zbar.
+EPS_FRACTION = 1.0 / 50.0
+
+
+def default_eps(model: Model) -> float:
+    """The default bin, ``kappa * zbar / 50`` (2e-3 for the paper's parameters)."""
+    return model.kappa * model.zbar * EPS_FRACTION
+
+
+@dataclass(frozen=True)
+class FP:
+    """The Fokker-Planck method's options (``method=micro.FP(...)`` or
+    ``numerics=micro.FP(...)``; :class:`Numerics` is its older name).
+
+    Parameters
+    ----------
+    eps : bin width of delta_F and delta_R; None: :func:`default_eps`, ``kappa zbar / 50``.
+        Its refinement variable (second order).
+    theta_shift, theta_relax : the step limits of the shift and the relaxation, in bins.
+    max_memory_gib : the memory the grid may take; beyond it a run raises
+        :class:`~micro.grid.GridTooLarge` instead of exhausting the machine.
+    """
+
+    name: ClassVar[str] = "fp"
+    eps: float | None = None
+    theta_shift: float = 0.5
+    theta_relax: float = 0.5
+    max_memory_gib: float = 4.0
+
+    def __post_init__(self) -> None:
+        _no_bool(self, ("eps", "theta_shift", "theta_relax", "max_memory_gib"))
+        if not (math.isfinite(self.max_memory_gib) and self.max_memory_gib > 0.0):
+            raise ValueError(f"max_memory_gib must be a finite number > 0, got {self.max_memory_gib!r}")
+        if self.eps is not None and not (math.isfinite(self.eps) and self.eps > 0.0):
+            raise ValueError(f"eps must be a finite number > 0 (or None for the default), got {self.eps!r}")
+        if not (0.0 < self.theta_shift <= 1.0):
+            raise ValueError(f"theta_shift must be in (0, 1], got {self.theta_shift!r}")
+        if not (0.0 < self.theta_relax <= 2.0):
+            raise ValueError(f"theta_relax must be in (0, 2], got {self.theta_relax!r}")
+
+    def settings(self, model: Model) -> GridSettings:
+        """The grid's settings for ``model`` (a ValueError naming eps if it is out of range)."""
+        eps = default_eps(model) if self.eps is None else float(self.eps)
+        settings = GridSettings(eps=eps, theta_shift=self.theta_shift, theta_relax=self.theta_relax, dt_max=math.inf,
+                                max_bytes=self.max_memory_gib * 2**30)
+        settings.check(model)
+        return settings
+
+
+@dataclass(frozen=True)
+class Convergence:
+    """When a stationary run stops.
+
+    Parameters
+    ----------
+    rtol : stick-slip: the last ``n`` cycles' sigma_max and sigma_min agree within
+        ``rtol`` times the stress drop and their periods within ``rtol`` (the paper:
+        1 % over three consecutive global shocks).  Steady: the last ``n`` stress means
+        agree within ``rtol`` times the velocity weakening ``|sigma - sigma_inf|``
+        (the paper: 1 % over three values) plus the grid's jitter ``k0 * eps``, plus
+        ``atol``.
+    atol : absolute stress tolerance added to both tests.
+    n : how many consecutive values or cycles must agree.
+    t_max : longest simulated time (None: 400 relaxation times, or 60 times the
+        time the drive needs to load one mean jump, whichever is longer).
+    """
+
+    rtol: float = 1e-2
+    atol: float = 1e-9
+    n: int = 3
+    t_max: float | None = None
+
+    def __post_init__(self) -> None:
+        _no_bool(self, ("rtol", "atol", "n", "t_max"))
+        if not (math.isfinite(self.rtol) and self.rtol > 0.0):
+            raise ValueError(f"rtol must be a finite number > 0, got {self.rtol!r}")
+        if not (math.isfinite(self.atol) and self.atol >= 0.0):
+            raise ValueError(f"atol must be a finite number >= 0, got {self.atol!r}")
+        if int(self.n) != self.n or self.n < 2:
+            raise ValueError(f"n must be an integer >= 2, got {self.n!r}")
+        if self.t_max is not None and not (math.isfinite(self.t_max) and self.t_max > 0.0):
+            raise ValueError(f"t_max must be a finite number > 0 (or None), got {self.t_max!r}")
+
+
+#: The older name of :class:`FP` (its options were the only numerics once).
+Numerics = FP
+
+
+#: Default time step of the cohort method (its error is second order in it).
+COHORT_DT = 0.01
+#: Default delta_R cell of the cohort method, in units of a mean jump kappa * zbar.
+COHORT_CELL = 1.0 / 20.0
+
+
+@dataclass(frozen=True)
+class Cohort:
+    """The cohort method's options (``method=micro.Cohort(...)``).
+
+    Parameters
+    ----------
+    dt : time step of the loading phase, in (0, 0.1] (default 0.01; the error is second
+        order in it).
+    h : delta_R cell, in (0, kappa zbar / 2]; None: ``kappa zbar / 20``.
+    tol : the fixed point's tolerance on sigma_max, sigma_min, sigma_before and
+        sigma_after, in units of stress, in [1e-9, 1e-2] (default 2e-5).
+    max_iter : most cycles the fixed-point iteration may take, >= 4.
+    """
+
+    name: ClassVar[str] = "cohort"
+    dt: float = COHORT_DT
+    h: float | None = None
+    tol: float = 2e-5
+    max_iter: int = 200
+
+    def __post_init__(self) -> None:
+        _no_bool(self, ("dt", "h", "tol", "max_iter"))
+        if not (isinstance(self.tol, (int, float)) and math.isfinite(self.tol) and 1e-9 <= self.tol <= 1e-2):
+            raise ValueError(f"Cohort tol must be in [1e-9, 1e-2], got {self.tol!r}")
+        if not (isinstance(self.dt, (int, float)) and math.isfinite(self.dt) and 0.0 < self.dt <= 0.1):
+            raise ValueError(f"Cohort dt must be a finite number in (0, 0.1], got {self.dt!r}")
+        if self.h is not None and not (isinstance(self.h, (int, float)) and math.isfinite(self.h) and self.h > 0.0):
+            raise ValueError(f"Cohort h must be a finite number > 0 (or None for kappa zbar / 20), got {self.h!r}")
+        if not (isinstance(self.max_iter, int) and self.max_iter >= 4):
+            raise ValueError(f"Cohort max_iter must be an integer >= 4, got {self.max_iter!r}")
+
+    def cell(self, model: Model) -> float:
+        """The delta_R cell for ``model``, or one ValueError naming h and its range."""
+        top = 0.5 * model.kappa * model.zbar
+        h = model.kappa * model.zbar * COHORT_CELL if self.h is None else float(self.h)
+        if not h <= top:
+            raise ValueError(f"Cohort h must be in (0, kappa zbar / 2 = {top:g}], got {h:g}")
+        return h
+
+
+@dataclass(frozen=True)
+class Renewal:
+    """The renewal chain's options (steady sliding, its spectrum and V^c).
+
+    Parameters
+    ----------
+    tol : the chain's grid is refined until sigma and the branching ratio change by
+        less than this; in [1e-13, 1e-3] (default 1e-11).
+    """
+
+    name: ClassVar[str] = "renewal"
+    tol: float = 1e-11
+
+    def __post_init__(self) -> None:
+        _no_bool(self, ("tol",))
+        if not (isinstance(self.tol, (int, float)) and math.isfinite(self.tol) and 1e-13 <= self.tol <= 1e-3):
+            raise ValueError(f"Renewal tol must be in [1e-13, 1e-3], got {self.tol!r}")
+
+
+@dataclass(frozen=True)
+class Auto:
+    """The default: the best method for each question.
+
+    Steady sliding (where it is stable) and V^c come from the renewal chain, stick-slip
+    cycles from the cohort method where it applies (exponential jumps), and the
+    Fokker-Planck equation answers only where nothing better applies or its state is
+    asked for (a transient, a slide-hold-slide, ``keep_grid``).
+
+    Parameters
+    ----------
+    renewal, cohort : the options of the methods it dispatches to; the Fokker-Planck
+        fallback takes the ``numerics`` argument.
+    """
+
+    name: ClassVar[str] = "auto"
+    renewal: Renewal = field(default_factory=Renewal)
+    cohort: Cohort = field(default_factory=Cohort)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.renewal, Renewal):
+            raise ValueError(f"Auto renewal must be a micro.Renewal, got {type(self.renewal).__name__}")
+        if not isinstance(self.cohort, Cohort):
+            raise ValueError(f"Auto cohort must be a micro.Cohort, got {type(self.cohort).__name__}")
+
+
+Method = Union[str, FP, Cohort, Renewal, Auto]
+
+#: The methods by name: each name gives its options object with the defaults.
+METHODS: dict[str, type] = {"auto": Auto, "renewal": Renewal, "cohort": Cohort, "fp": FP}
+#: Retired names, and what to use instead.
+RETIRED = {"cycle": "method='cycle' was retired (its cycles are wrong close to V^c): use method='cohort', or "
+                    "'auto' (the default), which solves the same stick-slip cycles at every k0"}
+
+
+def resolve(method: Method, allowed: tuple[str, ...], question: str):
+    """The options object for ``method`` (a name or an object), if ``question`` has that
+    method among ``allowed``; else one ValueError naming the choices."""
+    if isinstance(method, str):
+        if method in RETIRED:
+            raise ValueError(RETIRED[method])
+        if method not in allowed:
+            raise ValueError(f"{question}: method must be one of {', '.join(repr(m) for m in allowed)} "
+                             f"(or its options object), got {method!r}")
+        return METHODS[method]()
+    name = getattr(type(method), "name", None)
+    if not isinstance(name, str) or METHODS.get(name) is not type(method):
+        raise ValueError(f"{question}: method must be a name ({', '.join(repr(m) for m in allowed)}) or an options "
+                         f"object (micro.Auto, micro.Cohort, micro.Renewal, micro.FP), got {type(method).__name__}")
+    if name not in allowed:
+        raise ValueError(f"{question}: method must be one of {', '.join(repr(m) for m in allowed)}, got {name!r}")
+    return method
