@@ -205,7 +205,8 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     ax.set_title(f"micro's spectrum below V^c (k0 = {pts.k0.iloc[0]:g}); diverges at V^c", fontsize=9)
     ax.legend(fontsize=7)
     ax = axes[1]
-    styles = {("micro", "FP"): ("o", "C1"), ("micro", "N-block"): ("D", "C3"), ("RS", "CVODE"): ("s", "C0")}
+    styles = {("micro", "cohort"): ("o", "C1"), ("micro", "FP"): ("v", "C4"), ("micro", "N-block"): ("D", "C3"),
+              ("RS", "CVODE"): ("s", "C0")}
     for (name, method, res), grp in pts.groupby(["model", "method", "resolution"], dropna=False, sort=False):
         grp = grp[(grp.regime == "stick-slip") & (grp.amplitude > 0)].sort_values("d")
         if not len(grp):
@@ -214,8 +215,9 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
         coarse = method == "FP" and res == pts[pts.method == "FP"].resolution.max()
         small_N = method == "N-block" and res == pts[pts.method == "N-block"].resolution.min()
         mfc = "none" if (coarse or small_N) else c
-        lab = f"{name} {method}" + ("" if not math.isfinite(res) else (f" eps={res:g}" if method == "FP" else f" N={res:.0f}"))
-        yerr = grp.amplitude_stderr if method == "N-block" and "amplitude_stderr" in grp else None
+        lab = f"{name} {method}" + ("" if not math.isfinite(res) else (
+            f" N={res:.0f}" if method == "N-block" else f" h={res:.3g}" if method == "cohort" else f" eps={res:g}"))
+        yerr = grp.amplitude_stderr.fillna(0.0) if "amplitude_stderr" in grp and method != "CVODE" else None
         ax.errorbar(grp.d, grp.amplitude, yerr=yerr, fmt=mark, color=c, mfc=mfc, ms=5, label=lab)
         f = fit[(fit.model == name) & (fit.method == method) & (fit.resolution.fillna(-1) == (res if math.isfinite(res) else -1))]
         if len(f) and not (coarse or small_N):
@@ -227,7 +229,7 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     ax.set_yscale("log")
     ax.set_xlabel("d = (V^c - V) / V^c (each model's own exact V^c)")
     ax.set_ylabel("sigma_max - sigma_min")
-    ax.set_title("Amplitude near V^c (open: coarser bin / smaller N)", fontsize=9)
+    ax.set_title("Amplitude near V^c (open: smaller N; bars: error where known)", fontsize=9)
     ax.legend(fontsize=6)
     return _save(fig, path)
 

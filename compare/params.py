@@ -59,14 +59,15 @@ class Settings:
 
     Micro's steady branch and V^c are exact (the direct method, ``micro.steady_sliding``
     and ``micro.critical_velocity``, to 1e-11).  Its stick-slip points on the bifurcation
-    diagram are limit cycles solved by ``cycle_method``: ``"cohort"`` (the default,
-    :mod:`micro.cohort`: no grid in the margin, the cycle-to-cycle sequence extrapolated
-    to its fixed point within ``cycle_rtol`` times the velocity weakening ``f_th -
-    sigma_fast_limit``, about 1e-4 in stress) or ``"fp"`` (the Fokker-Planck equation at
-    the bin ``eps``, whose cycles are off by about 1e-3 at eps = 0.016).  The transition
-    study time-steps the Fokker-Planck equation at ``eps`` and ``eps_coarse`` with the
-    stopping rule ``rtol``, ``atol``, ``t_max`` (None: micro's default), and runs the
-    N-block simulation.
+    diagram and in the transition study are limit cycles solved by ``cycle_method``:
+    ``"cohort"`` (the default, micro's own default for cycles, :mod:`micro.cohort`: no grid
+    in the margin, the fixed point of the cycle map to ``cycle_rtol`` times the velocity
+    weakening ``f_th - sigma_fast_limit``, about 1e-4 in stress, each row with its
+    discretisation error where it is known) or ``"fp"`` (the Fokker-Planck equation at the
+    bin ``eps``, whose cycles are off by about 1e-3 at eps = 0.016).  The transition study
+    also runs the N-block simulation.  Slide-hold-slide and the traces time-step the
+    Fokker-Planck equation at ``eps`` with the stopping rule ``rtol``, ``atol``, ``t_max``
+    (None: micro's default).
 
     Parameters
     ----------
@@ -88,8 +89,8 @@ class Settings:
         small k0, where the fitted D_c is a prediction.
     cycle_method, cycle_rtol : how the stick-slip points are solved (above).
     dc_bounds, dc_grid, bootstrap : D_c search range, scan resolution, bootstrap samples.
-    hopf_k0 : k0 of the transition study; ``hopf_distances``: d = (V^c - V)/V^c of its FP
-        points (at ``eps`` and ``eps_coarse``); ``nblock_N``, ``nblock_distances``: the
+    hopf_k0 : k0 of the transition study; ``hopf_distances``: d = (V^c - V)/V^c of its
+        cycles (by ``cycle_method``); ``nblock_N``, ``nblock_distances``: the
         N-block sizes and distances; ``rs_hopf_distances``: the RS ones.
     phase_sets : (k1, k2) sets of Fig. 5; ``phase_points`` k0 per set, log-spaced from
         ``phase_k0_min`` to 0.98 k2 (micro has no stick-slip for k0 >= k2);
@@ -110,7 +111,6 @@ class Settings:
     zbar: float = 0.1
     cutoff: float = 10.0
     eps: float = 0.016
-    eps_coarse: float = 0.025
     rtol: float = 1e-2
     atol: float = 1e-4
     t_max: float | None = None
@@ -133,7 +133,7 @@ class Settings:
     bootstrap: int = 400
     rs_points: int = 50
     hopf_k0: float = 0.1
-    hopf_distances: tuple[float, ...] = (0.3, 0.45, 0.6)
+    hopf_distances: tuple[float, ...] = (0.2, 0.3, 0.45, 0.6)
     nblock_N: tuple[int, ...] = (30000, 100000)
     nblock_distances: tuple[float, ...] = (0.02, 0.05, 0.1, 0.2, 0.3)
     rs_hopf_distances: tuple[float, ...] = _geom(1e-3, 0.6, 12)
@@ -161,9 +161,6 @@ class Settings:
         if self.cutoff <= self.zbar:
             raise ValueError(f"cutoff must be > zbar = {self.zbar!r}, got {self.cutoff!r}")
         set_("eps", positive("eps", self.eps))
-        set_("eps_coarse", positive("eps_coarse", self.eps_coarse))
-        if not self.eps_coarse > self.eps:
-            raise ValueError(f"eps_coarse must be > eps = {self.eps!r}, got {self.eps_coarse!r}")
         set_("rtol", in_range("rtol", self.rtol, 0.0, 0.5, low_open=True))
         set_("atol", in_range("atol", self.atol, 0.0, 0.1))
         if self.t_max is not None:
@@ -225,7 +222,7 @@ class Settings:
         set_("scenarios", choices("scenarios", self.scenarios, SCENARIOS))
         # every time-stepped micro model must accept the bins
         for k0 in self.fp_k0 + (self.hopf_k0, self.shs_k0):
-            for eps in (self.eps, self.eps_coarse):
+            for eps in (self.eps,):
                 self.numerics(eps).settings(self.model(k0))
 
     # -- presets ---------------------------------------------------------------------------
@@ -238,7 +235,7 @@ class Settings:
     def quick(cls, **changes: Any) -> Settings:
         """A smoke run (seconds once compiled): few points, a coarse bin.  Its numbers only
         show that the pipeline works."""
-        base = cls(eps=0.02, eps_coarse=0.025, branch_points=12, unstable_points=6, reference_V=_geom(1e-3, 1e3, 13),
+        base = cls(eps=0.02, branch_points=12, unstable_points=6, reference_V=_geom(1e-3, 1e3, 13),
                    fp_points=((0.1, 0.2), (0.1, 0.4), (0.1, 0.6)), shown_points=((0.001, 0.5),), cycle_rtol=1e-2,
                    steady_ratios=(1.5,), dc_grid=13, bootstrap=50,
                    rs_points=12, hopf_k0=0.1, hopf_distances=(0.4, 0.6, 0.8), nblock_N=(3000, 10000),
@@ -255,7 +252,7 @@ class Settings:
                                    [(0.1, r) for r in (0.05, 0.15, 0.3, 0.4, 0.55, 0.7, 0.85)]),
                    shown_points=tuple((k0, r) for k0 in (0.01, 0.001, 0.0001) for r in (0.15, 0.4, 0.55, 0.7, 0.85)),
                    steady_ratios=(1.2, 1.5, 2.0, 3.0, 5.0),
-                   hopf_distances=(0.15, 0.3, 0.45, 0.6), nblock_N=(100000, 300000),
+                   hopf_distances=(0.1, 0.2, 0.3, 0.45, 0.6), nblock_N=(100000, 300000),
                    nblock_distances=(0.01, 0.02, 0.03, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5),
                    rs_hopf_distances=_geom(1e-4, 0.6, 20), phase_points=48,
                    phase_reference_V=_geom(1e-3, 1e3, 37),

@@ -4,11 +4,14 @@ r"""The whole comparison: micro and RS side by side, as tables, figures and ``su
 ``hopf``, ``phase``, ``shs``) and returns a :class:`Report` whose tables are pandas
 DataFrames; with ``out`` it also writes them as CSV, the figures as PNG and a summary.
 
-Micro's stationary questions are answered directly (:func:`micro.critical_velocity` and
-:func:`micro.steady_sliding`: the renewal chain of one block, milliseconds per V); the
-stick-slip points of the diagram are limit cycles solved as fixed points of the cycle map
-(:mod:`micro.cohort`, seconds per point at every k0); the transition study time-steps
-(the Fokker-Planck equation at two bins, the N-block simulation at two sizes).  Stages
+Micro answers by its defaults: the stationary questions directly
+(:func:`micro.critical_velocity` and :func:`micro.steady_sliding`: the renewal chain of
+one block, milliseconds per V); the stick-slip points of the diagram and of the
+transition study are limit cycles solved as fixed points of the cycle map
+(:mod:`micro.cohort`, seconds per point at every k0, each with its discretisation error
+where it is known), checked in the transition study by the N-block simulation at two
+sizes; slide-hold-slide and the paper's traces time-step the Fokker-Planck equation (the
+only method that carries a transient), and the paper's Fig. 10 is the FP against its bin.  Stages
 are computed when a scenario needs them and shared between scenarios:
 
 * micro's exact V^c at every k0 (and at dozens of k0 per (k1, k2) set for the phase
@@ -16,7 +19,8 @@ are computed when a scenario needs them and shared between scenarios:
   unstable mode below it);
 * the Eq. (10) fit to that branch (shared A, B, one offset per k0) with its residual
   against the exact tail and offset;
-* the stick-slip points (cohort or FP, N-block), every one in one batch on the runner;
+* the stick-slip points (micro's default, the cohort method; the N-block), every one in
+  one batch on the runner;
 * D_c two ways: from the stick-slip extrema (:func:`~compare.fits.fit_dc`) and from V^c
   matching (:func:`~compare.fits.fit_dc_critical`).
 
@@ -69,7 +73,8 @@ def micro_frame(records: Sequence[dict[str, Any]], **columns: Any) -> pd.DataFra
         row["status"] = rec.get("status")
         row["error"] = rec.get("error", "")
         row["wall_time"] = rec.get("wall_time", math.nan)
-        row["eps"] = task.get("numerics", {}).get("eps", math.nan)
+        if not math.isfinite(row.get("eps", math.nan)):  # (the FP's bin where the row has no resolution)
+            row["eps"] = task.get("numerics", {}).get("eps", math.nan)
         rows.append(row)
     frame = pd.DataFrame(rows)
     for k, v in columns.items():
@@ -260,17 +265,17 @@ class _Study:
         s = self.s
         return StationaryTask(s.model(k0), _sig(V), s.numerics(eps), s.convergence(), method)
 
-    def _cycle_task(self, k0: float, ratio: float) -> StationaryTask:
-        """Micro's stick-slip cycle at ``ratio`` V^c by ``cycle_method``: the cohort method
-        at its default cell (kappa zbar / 20) to ``cycle_rtol`` of the velocity weakening,
-        or the FP at ``eps``."""
+    def _cycle_task(self, k0: float, V: float) -> StationaryTask:
+        """Micro's stick-slip cycle at V by ``cycle_method``: ``"auto"``, micro's default
+        (the cohort method at its default step and cell, its fixed point to ``cycle_rtol``
+        of the velocity weakening), or the FP at ``eps``."""
         s = self.s
-        V = _sig(ratio * self.Vc(k0))
         if s.cycle_method == "fp":
             return self._stationary_task(k0, V, s.eps, "fp")
         model = s.model(k0)
-        return StationaryTask(model, V, micro.Numerics(eps=model.kappa * model.zbar / 20.0),
-                              micro.Convergence(rtol=s.cycle_rtol, atol=0.0), "cohort")
+        tol = s.cycle_rtol * (model.f_th - micro.sigma_fast_limit(model))
+        return StationaryTask(model, V, s.numerics(), s.convergence(), "auto",
+                              cohort=micro.Cohort(tol=min(max(tol, 1e-9), 1e-2)))
 
     def _diagram_tasks(self, fitted: bool = True) -> list[StationaryTask]:
         """The stick-slip points: those the D_c fit matches (with ``fitted``), and those
@@ -279,12 +284,11 @@ class _Study:
         return self._cycle_tasks((list(s.fp_points) if fitted else []) + list(s.shown_points))
 
     def _cycle_tasks(self, pairs) -> list[StationaryTask]:
-        return [self._cycle_task(k0, r) for k0, r in pairs if self.Vc(k0) > 0]
+        return [self._cycle_task(k0, _sig(r * self.Vc(k0))) for k0, r in pairs if self.Vc(k0) > 0]
 
     def _points(self, pairs, role: str) -> pd.DataFrame:
         """The stick-slip cycles at ``pairs`` (k0, V / V^c), with their k0's V^c."""
-        frame = micro_frame(self._run(self._cycle_tasks(pairs), "micro stick-slip"), role=role,
-                            method=self.s.cycle_method)
+        frame = micro_frame(self._run(self._cycle_tasks(pairs), "micro stick-slip"), role=role)
         frame["Vc"] = [self.Vc(k) for k in frame.k0]
         return frame
 
@@ -430,13 +434,13 @@ class _Study:
         if s.paper_figures:
             self._paper_figures()
 
-    def _hopf_fp_tasks(self) -> list[StationaryTask]:
+    def _hopf_cycle_tasks(self) -> list[StationaryTask]:
+        """The transition's cycles by micro's default (``cycle_method``), one per distance."""
         s = self.s
         vc = self.Vc(s.hopf_k0)
         if vc <= 0:
             return []
-        return [self._stationary_task(s.hopf_k0, vc * (1 - d), eps) for eps in (s.eps, s.eps_coarse)
-                for d in s.hopf_distances]
+        return [self._cycle_task(s.hopf_k0, _sig(vc * (1 - d))) for d in s.hopf_distances]
 
     def _hopf_nblock_tasks(self) -> list[NBlockTask]:
         s = self.s
@@ -447,21 +451,24 @@ class _Study:
                 for d in s.nblock_distances]
 
     def _hopf_tasks(self) -> list:
-        return self._hopf_fp_tasks() + self._hopf_nblock_tasks()
+        return self._hopf_cycle_tasks() + self._hopf_nblock_tasks()
 
     def hopf(self) -> None:
         """The transition at ``hopf_k0``: micro's spectrum and its stick-slip amplitude
-        against (V^c - V)/V^c (FP at two bins, N-block at two sizes) next to RS's Hopf
-        scaling, each against its own V^c."""
+        against (V^c - V)/V^c (micro's default method, the cohort's cycles with their
+        error where it is known; the N-block at two sizes) next to RS's Hopf scaling, each
+        against its own V^c."""
         s = self.s
         k0 = s.hopf_k0
         vc = self.Vc(k0)
         rows = []
-        fp, nb = self._hopf_fp_tasks(), self._hopf_nblock_tasks()
-        for eps in (s.eps, s.eps_coarse):
-            tasks = [t for t in fp if t.numerics.eps == eps]
-            f = micro_frame(self._run(tasks, "micro amplitude (FP)"))
-            f["method"], f["resolution"] = "FP", eps
+        cyc, nb = self._hopf_cycle_tasks(), self._hopf_nblock_tasks()
+        f = micro_frame(self._run(cyc, "micro amplitude"))
+        if len(f):
+            f["resolution"] = f["eps"]
+            # an error bar on each extremum: the discretisation's (NaN where not known) and the fixed point's
+            if "discretisation_error" in f:
+                f["amplitude_stderr"] = 2.0 * (f.discretisation_error + f.sigma_stderr)
             rows.append(f)
         for N in s.nblock_N:
             tasks = [t for t in nb if t.n_blocks == N]
@@ -477,7 +484,9 @@ class _Study:
             micro_pts["d"] = 1.0 - micro_pts.V / vc
             micro_pts["amplitude"] = micro_pts.sigma_max - micro_pts.sigma_min
             if "sigma_max_stderr" in micro_pts:
-                micro_pts["amplitude_stderr"] = np.hypot(micro_pts.sigma_max_stderr, micro_pts.sigma_min_stderr)
+                nb_rows = micro_pts.method == "N-block"
+                micro_pts.loc[nb_rows, "amplitude_stderr"] = np.hypot(micro_pts.sigma_max_stderr,
+                                                                      micro_pts.sigma_min_stderr)[nb_rows]
         model = rsf.SpringSlider(law=self.law_for(k0), k0=k0, Dc=self.Dc)
         rs = rs_hopf(model, s.rs_hopf_distances)
         rs["model"], rs["k0"], rs["method"], rs["resolution"] = "RS", k0, "CVODE", math.nan

@@ -6,7 +6,9 @@ from typing import Any
 
 import numpy as np
 
+import micro
 import rsf
+from micro.api import NEAR_VC
 
 from .params import PAPER_K0
 
@@ -141,7 +143,7 @@ def _bifurcation(study, t, v) -> list[str]:
     if "rs_bifurcation" not in t:
         return []
     s = study.s
-    how = ("limit cycles by the cohort method (fixed points of the cycle map, to "
+    how = ("micro's default method, the cohort method (limit cycles as fixed points of the cycle map, to "
            f"{s.cycle_rtol:g} of the velocity weakening)" if s.cycle_method == "cohort"
            else f"the Fokker-Planck equation (eps = {s.eps:g})")
     shown = sorted({k for k, _ in s.shown_points}, reverse=True)
@@ -166,6 +168,11 @@ def _bifurcation(study, t, v) -> list[str]:
     return lines
 
 
+def s_dt(study) -> str:
+    """The cohort method's time step of the report's cycles."""
+    return f"{micro.Cohort().dt:g}"
+
+
 def _hopf(study, t, v) -> list[str]:
     if "hopf_fit" not in t:
         return []
@@ -174,15 +181,18 @@ def _hopf(study, t, v) -> list[str]:
              "Amplitude sigma_max − sigma_min ∝ d^beta, d = (V^c − V)/V^c with each model's own exact V^c:", "",
              "| model | method | resolution | beta | ± | points |", "|---|---|---|---|---|---|"]
     for _, r in t["hopf_fit"].iterrows():
-        res = "" if not math.isfinite(r.resolution) else (f"eps = {r.resolution:g}" if r.method == "FP"
-                                                          else f"N = {r.resolution:.0f}")
+        res = "" if not math.isfinite(r.resolution) else (
+            f"N = {r.resolution:.0f}" if r.method == "N-block" else
+            f"h = {r.resolution:.3g}, dt = {s_dt(study)}" if r.method == "cohort" else f"eps = {r.resolution:g}")
         lines.append(f"| {r.model} | {r.method} | {res} | {_fmt(r.exponent, 3)} | {_fmt(r.exponent_err, 2)} | "
                      f"{int(r.n_points)} |")
     tr = v.get("transition", {})
     lines += ["", tr.get("text", ""), "",
-              "The Fokker-Planck amplitudes at the two bins differ near V^c, where the cycle is a few bins "
-              "high: their difference is the error bar drawn in `hopf.png`; the N-block sizes differ by "
-              "their finite-N error.", ""]
+              "Micro's cycles come from its default method, the cohort method: each point's error bar in "
+              "`hopf.png` is twice the sum of its discretisation error (the change from twice the time step and "
+              f"cell) and its fixed-point error; closer to V^c than d = {NEAR_VC:g} the discretisation error is "
+              "not known (the cell refinement is not yet shown to converge there), and such points carry no bar. "
+              "The N-block sizes differ by their finite-N error.", ""]
     return lines
 
 
@@ -284,9 +294,12 @@ def summary(study, rep) -> str:
              f"({st.computed} micro tasks computed, {st.cached} from the cache, {st.compute_seconds:.1f} s of micro "
              f"compute, {st.warm_up_seconds:.1f} s loading or compiling kernels).", "",
              f"Model: k1 = {s.k1:g}, k2 = {s.k2:g}, exponential jumps zbar = {s.zbar:g} (cutoff {s.cutoff:g}), "
-             f"eta_u = f_th = 1. Micro's steady branch and V^c are exact (direct method); its stick-slip cycles "
-             f"come from the Fokker-Planck equation at eps = {s.eps:g} (and {s.eps_coarse:g}) and from the N-block "
-             f"simulation.", ""]
+             f"eta_u = f_th = 1. Micro's steady branch and V^c are exact (the renewal chain, micro's default for "
+             f"them); its stick-slip cycles come from "
+             + ("the cohort method (micro's default for cycles)" if s.cycle_method == "cohort"
+                else f"the Fokker-Planck equation at eps = {s.eps:g}")
+             + ", checked by the N-block simulation in the transition study; slide-hold-slide and the traces "
+             f"come from the Fokker-Planck equation at eps = {s.eps:g} (micro's only method for a transient).", ""]
     lines += _warnings(study, t)
     lines += _steady(study, t, v)
     lines += _critical(study, t)

@@ -47,7 +47,7 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 #: Bump when the meaning or layout of a task's record changes.
-TASK_FORMAT = 2
+TASK_FORMAT = 3
 #: The methods of micro.stationary a StationaryTask may ask for.
 STATIONARY_METHODS = ("auto", "fp", "cohort")
 
@@ -89,8 +89,12 @@ def model_from_description(d: dict[str, Any]) -> micro.Model:
 
 def _numerics_description(numerics: micro.Numerics, model: micro.Model) -> dict[str, Any]:
     eps = micro.default_eps(model) if numerics.eps is None else float(numerics.eps)
-    return {"eps": eps, "theta_shift": float(numerics.theta_shift), "theta_relax": float(numerics.theta_relax),
-            "cohort_dt": float(numerics.cohort_dt)}
+    return {"eps": eps, "theta_shift": float(numerics.theta_shift), "theta_relax": float(numerics.theta_relax)}
+
+
+def _cohort_description(cohort: micro.Cohort, model: micro.Model) -> dict[str, Any]:
+    return {"dt": float(cohort.dt), "h": float(cohort.cell(model)), "tol": float(cohort.tol),
+            "max_iter": int(cohort.max_iter)}
 
 
 def _convergence_description(conv: micro.Convergence) -> dict[str, Any]:
@@ -128,32 +132,40 @@ class _TaskBase:
 
 @dataclass(frozen=True)
 class StationaryTask(_TaskBase):
-    """``micro.stationary(model, V, numerics=..., convergence=..., method=...)`` (``method="fp"``
-    time-steps the Fokker-Planck equation even where the direct steady state exists;
-    ``method="cohort"`` solves a stick-slip cycle by the cohort method, with ``numerics.eps``
-    its delta_R cell)."""
+    """``micro.stationary(model, V, method=..., numerics=..., convergence=...)``: ``"auto"``
+    (the renewal chain where steady sliding is stable, the cohort method with the options
+    ``cohort`` for a stick-slip cycle), ``"cohort"``, or ``"fp"`` (time-steps the
+    Fokker-Planck equation at ``numerics`` even where the direct steady state exists)."""
 
     model: micro.Model
     V: float
     numerics: micro.Numerics
     convergence: micro.Convergence
     method: str = "auto"
+    cohort: micro.Cohort = micro.Cohort()
     kind = "stationary"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "V", positive("V", self.V))
         if self.method not in STATIONARY_METHODS:
             raise ValueError(f"method must be one of {', '.join(map(repr, STATIONARY_METHODS))}, got {self.method!r}")
+        if not isinstance(self.cohort, micro.Cohort):
+            raise ValueError(f"cohort must be a micro.Cohort, got {type(self.cohort).__name__}")
         _check_common(self.model, self.numerics, self.convergence)
+        self.cohort.cell(self.model)
 
     def describe(self) -> dict[str, Any]:
-        return {"kind": self.kind, "model": model_description(self.model), "V": self.V,
-                "numerics": _numerics_description(self.numerics, self.model),
-                "convergence": _convergence_description(self.convergence), "method": self.method}
+        d = {"kind": self.kind, "model": model_description(self.model), "V": self.V, "method": self.method,
+             "numerics": _numerics_description(self.numerics, self.model),
+             "convergence": _convergence_description(self.convergence)}
+        if self.method != "fp":
+            d["cohort"] = _cohort_description(self.cohort, self.model)
+        return d
 
     def run(self) -> dict[str, Any]:
+        method = {"auto": micro.Auto(cohort=self.cohort), "cohort": self.cohort, "fp": "fp"}[self.method]
         res = micro.stationary(self.model, self.V, numerics=self.numerics, convergence=self.convergence,
-                               method=self.method)
+                               method=method)
         return res.to_dict()
 
 
