@@ -92,10 +92,32 @@ def _renewal_row(model: Model, V: float, opts: Renewal) -> Stationary | None:
         shocks_per_cycle=0.0, mass_error=0.0, min_mass=0.0, method="renewal", discretisation_error=error)
 
 
+#: A cohort cycle of more loading steps than this is announced up front with its cost.
+SLOW_CYCLE_STEPS = 2e5
+
+
+def cohort_steps_per_cycle(model: Model, V: float, dt: float) -> float:
+    """About how many time steps one loading phase of the cohort method takes at V: the
+    stress rises by the velocity weakening ``f_th - sigma_fast_limit`` at the rate
+    ``k0 V``, in steps of up to ``GRADED_MAX dt`` (4 dt) away from the shocks."""
+    from .analytic import sigma_fast_limit
+    from .cohort import GRADED_MAX
+
+    return (model.f_th - sigma_fast_limit(model)) / (model.k0 * V) / (GRADED_MAX * dt)
+
+
 def _cohort_row(model: Model, V: float, opts: Cohort, warn: bool,
                 start: CycleFixedPoint | None) -> Stationary | None:
     """The stick-slip cycle by the cohort method, or None where it does not apply."""
     h = opts.cell(model)
+    steps = cohort_steps_per_cycle(model, V, opts.dt)
+    if steps > SLOW_CYCLE_STEPS:
+        # (a slow drive: each cycle's loading phase is long; said before the first cycle, so that a
+        # user is not left waiting in silence; -v shows each cycle as it ends)
+        log.warning("micro.stationary(k0=%g, V=%g): a slow drive for the cohort method: each cycle loads for "
+                    "about %.2g time units, %.2g steps of dt = %g, and 10-20 cycles are needed; this may take "
+                    "%s", model.k0, V, steps * 4.0 * opts.dt, steps, opts.dt,
+                    "hours" if steps > 1e7 else "minutes")
     res = cycle_cohorts(model, V, dt=opts.dt, h=h, tol=opts.tol, max_iter=opts.max_iter, start=start)
     if not res.applicable:
         return None
