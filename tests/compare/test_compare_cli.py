@@ -159,20 +159,50 @@ def test_killed_run_leaves_no_worker_behind(sig, tmp_path):
             time.sleep(0.1)
         kids = _children(proc.pid)
         assert len(kids) >= 2, "the pool never started"
-        start = time.monotonic()
         proc.send_signal(getattr(signal, sig))
-        _, err = proc.communicate(timeout=30)
-        took = time.monotonic() - start
+        _, err = proc.communicate(timeout=30)  # (a hang, not a speed limit: see the test below)
         deadline = time.monotonic() + 10
         while any(_alive(k) for k in kids) and time.monotonic() < deadline:
             time.sleep(0.1)
         assert not [k for k in kids if _alive(k)]
         if sig != "SIGKILL":
-            assert proc.returncode == 130 and took < 3.0
+            assert proc.returncode == 130
             assert err.strip().splitlines()[-1].startswith("interrupted:") and "Traceback" not in err
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+def test_an_interrupt_terminates_running_tasks_instead_of_waiting_for_them():
+    # why Ctrl-C no longer takes 22 s (was checked as under 3 s of wall clock): an exception
+    # inside the runner's context terminates each pool worker and shuts the pool down
+    # without waiting; a normal exit waits for the running tasks
+    from compare.cache import NullCache
+    from compare.runner import Runner
+
+    calls = []
+
+    class Worker:
+        def terminate(self):
+            calls.append("terminate")
+
+    class Pool:
+        _processes = {1: Worker(), 2: Worker()}
+
+        def shutdown(self, wait=True, cancel_futures=False):
+            calls.append(("shutdown", wait))
+
+    runner = Runner(NullCache(), workers=2, progress=False)
+    runner._pool = Pool()
+    with pytest.raises(KeyboardInterrupt):
+        with runner:
+            raise KeyboardInterrupt
+    assert calls == ["terminate", "terminate", ("shutdown", False)]
+    calls.clear()
+    runner._pool = Pool()
+    with runner:
+        pass
+    assert calls == [("shutdown", True)]
 
 
 @pytest.mark.parametrize("argv, settings, kwargs", [
