@@ -28,7 +28,7 @@ from .analysis import critical_velocity
 from .laws import (PAPER_A, PAPER_B, PAPER_DC, PAPER_K0_MAX, HyperbolicLaw, LogLaw, TabulatedLaw,
                    ViscoelasticLaw)
 from ._validation import positive
-from .params import Protocol, SolverOptions, SpringSlider
+from .params import T_END_MAX, Protocol, SolverOptions, SpringSlider
 from .results import write_atomically
 from .state_laws import NagataLaw, SecondState
 from .solver import simulate, sweep
@@ -39,7 +39,8 @@ logger = logging.getLogger(__name__)
 
 
 #: Documented upper bounds on magnitudes (beyond them a run loses its digits or never ends).
-K0_MAX, V_MAX, T_END_MAX, N_V_MAX = 1e3, 1e7, 1e8, 10_000
+#: T_END_MAX is rsf.params.T_END_MAX, the bound of rsf.simulate's t_end.
+K0_MAX, V_MAX, N_V_MAX = 1e3, 1e7, 10_000
 
 
 def _floats(text: str) -> list[float]:
@@ -314,9 +315,10 @@ def build_parser() -> argparse.ArgumentParser:
                                     "(steady or stick-slip), sigma_max, sigma_min, sigma_mean, "
                                     "period, converged, status, message, n_cycles.")
     ps.add_argument("--V", type=_floats, default=None,
-                    help="driving velocities, comma-separated (e.g. 0.1,1,10)")
+                    help=f"driving velocities, comma-separated (e.g. 0.1,1,10), each in (0, {V_MAX:g}]")
     ps.add_argument("--V-range", type=float, nargs=3, metavar=("VMIN", "VMAX", "N"), default=None,
-                    help="alternatively N log-spaced velocities from VMIN to VMAX")
+                    help=f"alternatively N log-spaced velocities from VMIN to VMAX (0 < VMIN < VMAX <= "
+                         f"{V_MAX:g}, N an integer in [1, {N_V_MAX}])")
     ps.add_argument("--out", default=None, help="output CSV (default: standard output)")
     _add_model_options(ps)
     _add_solver_options(ps)
@@ -332,7 +334,8 @@ def build_parser() -> argparse.ArgumentParser:
                         description="Integrate from the (perturbed) steady state and write the "
                                     "samples t, x, sigma, theta, v; a slip appears as two rows "
                                     "at one time.")
-    pr.add_argument("--V", type=float, default=None, help="constant driving velocity V > 0")
+    pr.add_argument("--V", type=float, default=None,
+                    help=f"constant driving velocity, in (0, {V_MAX:g}]")
     pr.add_argument("--steps", default=None,
                     help="velocity steps V1:T1,V2:T2,...,Vn (velocity:duration, last open-ended)")
     pr.add_argument("--shs", type=float, nargs=3, metavar=("V", "SLIDE", "HOLD"), default=None,
@@ -340,7 +343,8 @@ def build_parser() -> argparse.ArgumentParser:
     pr.add_argument("--history", default=None,
                     help="sampled load-point velocity V(t): a CSV file with columns t and V "
                          "(t from 0, strictly increasing), linear between the samples (a > 0)")
-    pr.add_argument("--t-end", type=float, required=True, help="end time > 0")
+    pr.add_argument("--t-end", type=float, required=True,
+                    help=f"end time, in (0, {T_END_MAX:g}] (the bound of rsf.simulate's t_end)")
     pr.add_argument("--out", required=True, help="output CSV for the time series")
     pr.add_argument("--events", default=None, help="output CSV for the events t, kind, sigma, theta, x")
     pr.add_argument("--t-eval", type=_floats, default=None,

@@ -31,7 +31,12 @@ from .state_laws import (
     state_law_from,
 )
 
-__all__ = ["SpringSlider", "Protocol", "InitialState", "SolverOptions", "standard_rs"]
+__all__ = ["SpringSlider", "Protocol", "InitialState", "SolverOptions", "standard_rs", "T_END_MAX"]
+
+#: The longest run :func:`rsf.simulate` and ``rsf run --t-end`` accept (one bound for both).
+#: A steady slide is followed to it in a few CVODE runs; a run of stick-slip cycles that long
+#: ends at ``SolverOptions.max_events`` or ``max_rhs_evals`` with its status.
+T_END_MAX = 1e8
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,7 @@ from ._validation import positive
 from .laws import LogLaw
 from .analysis import stability_margin
 from .state_laws import NAGATA, USER
-from .params import InitialState, Protocol, SolverOptions, SpringSlider
+from .params import T_END_MAX, InitialState, Protocol, SolverOptions, SpringSlider
 from .results import STATUS_MESSAGES, CycleResult, Event, Status, SweepResult, Trajectory
 
 __all__ = ["simulate", "limit_cycle", "sweep"]
@@ -45,10 +45,20 @@ logger = logging.getLogger(__name__)
 
 _THETA_FLOOR = 1e-250   # smallest theta resolved, in units of Dc (slips level off below)
 _ZERO_PHASES = 20       # consecutive zero-length phases before giving up
-_TAU_CHUNK = 1e4        # length of one CVODE run in the slide time tau (and in units of
+_TAU_CHUNK = 1e4        # length of the first CVODE run in the slide time tau (and in units of
                         # the natural time scale for the a > 0 ODE)
+_CHUNK_GROWTH = 30      # a = 0: the runs of one slide double in length, up to 2**30 _TAU_CHUNK,
+                        # so that a long steady slide takes tens of runs, not millions (the a > 0
+                        # engine follows a steady state it has reached in closed form instead)
 _RUNAWAY_FACTOR = 1e3   # default runaway bound: v_max = 1e3 max V (LogLaw models)
 _PROGRESS_CYCLES = 1000  # limit_cycle logs its progress (INFO) every this many cycles
+
+
+def _chunk_span(chunk: int) -> float:
+    """The length in tau of the ``chunk``-th CVODE run (from 0) of one slide of the a = 0
+    model: ``_TAU_CHUNK``, then doubling.  CVODE ties its smallest step to the output time,
+    so an open-ended run is not an option, but a settled slide lasts as long as the driving."""
+    return _TAU_CHUNK * 2.0 ** min(chunk, _CHUNK_GROWTH)
 
 
 class _Kernels:
@@ -337,10 +347,11 @@ class _PhaseEngine:
         nfev = 0
         terminal = (True, True, True, False, True)
         direction = (-1, -1, -1, 0, 1)
-        for _ in range(100000):
+        for chunk in range(100000):
+            span = _chunk_span(chunk)
             save_steps = self.record and self.t_eval is None
             if (out_times is not None and out_times.size) or save_steps:
-                sol = integrate_outputs(rhs, y0, tau0, tau0 + _TAU_CHUNK, out_index=1,
+                sol = integrate_outputs(rhs, y0, tau0, tau0 + span, out_index=1,
                                         out_times=out_times, events=events, terminal=terminal,
                                         direction=direction, rtol=opts.rtol, atol=atol,
                                         method=opts.method, max_num_steps=opts.max_num_steps,
@@ -349,7 +360,7 @@ class _PhaseEngine:
                 if out_times is not None:
                     out_times = out_times[n_found:]
             else:
-                sol = integrate(rhs, y0, tau0, tau0 + _TAU_CHUNK, events=events,
+                sol = integrate(rhs, y0, tau0, tau0 + span, events=events,
                                 terminal=terminal, direction=direction,
                                 rtol=opts.rtol, atol=atol, method=opts.method,
                                 max_num_steps=opts.max_num_steps)
@@ -611,6 +622,13 @@ class _SmoothEngine:
                 self._record(self.y[None, :])
             self.next_out += 1
 
+    def _distance_to_steady(self, lnV: float) -> float:
+        """|ln v - ln V| + |ln(theta/Dc) + ln V| (+ the same for theta2)."""
+        out = abs(self.y[0] - lnV) + abs(self.y[1] + lnV)
+        if self.second is not None:
+            out += abs(self.y[5] + lnV)
+        return float(out)
+
     def _steady_exactly(self, lnV: float) -> bool:
         tol = 4.0 * np.finfo(float).eps * (1.0 + abs(lnV))
         if self.second is not None and abs(self.y[5] + lnV) > tol:
@@ -776,6 +794,12 @@ class _SmoothEngine:
             y_loc = sol.y[-1].copy()
             self.at_root = False
         s0 = 0.0
+        # a stable steady state, reached to within the integrator's tolerance, is followed in
+        # closed form to the end of the segment: at round-off distance CVODE's steps shrink
+        # to the noise of the right-hand side and a long run would never end
+        snap = (V > 0.0 and slope == 0.0 and math.isfinite(t_stop)
+                and stability_margin(m, V) < 0.0)
+        snap_tol = max(opts.rtol, opts.atol)
         for _ in range(100000):
             sol = run(y_loc, s0, s0 + _TAU_CHUNK, True)
             if save_steps:
@@ -794,6 +818,12 @@ class _SmoothEngine:
             self.y = to_global(y_loc)
             if sol.terminal_event is not None:
                 break
+            if snap and self._distance_to_steady(lnV) <= snap_tol:
+                self.y[0], self.y[1] = lnV, -lnV
+                if second is not None:
+                    self.y[5] = -lnV
+                self.y[2] = self.protocol.load_point(self.t) - self.spring_of(self.y) / m.k0
+                return self._advance_steady(V, t_stop, t_end)
         else:
             raise _Stop(Status.SOLVER_FAILED, f"no progress at t = {self.t:.10g}")
         if sol.terminal_event == 1:
@@ -864,7 +894,9 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     V : float, optional
         Constant load-point velocity (> 0); or give ``protocol``.
     t_end : float
-        End time, > 0.
+        End time, in (0, ``rsf.params.T_END_MAX`` = 1e8].  A stable steady slide is followed
+        to it in a few integrator runs (once within the tolerance of the steady state, in
+        closed form for :math:`a > 0`).
     protocol : Protocol, optional
         Driving history (velocity steps, slide-hold-slide, a sampled V(t)).
     initial : InitialState, optional
@@ -889,6 +921,8 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     t_end = positive("t_end", t_end)
+    if t_end > T_END_MAX:
+        raise ValueError(f"t_end must be <= {T_END_MAX:g} (rsf.params.T_END_MAX), got {t_end:g}")
     protocol = _protocol_from(V, protocol)
     initial = initial or InitialState()
     initial = initial.resolved(InitialState.DEFAULT_PERTURBATION if protocol.is_constant else 0.0)
@@ -942,7 +976,7 @@ def _check_t_eval(t_eval, t_end: float) -> np.ndarray | None:
     if not np.all(np.isfinite(arr)) or np.any(np.diff(arr) <= 0.0):
         raise ValueError("t_eval must be finite and strictly increasing")
     if arr[0] < 0.0 or arr[-1] > t_end:
-        raise ValueError(f"t_eval must lie in [0, t_end = {t_end!r}], got [{arr[0]!r}, {arr[-1]!r}]")
+        raise ValueError(f"t_eval must lie in [0, t_end = {t_end:g}], got [{arr[0]:g}, {arr[-1]:g}]")
     arr = arr.copy()
     arr.setflags(write=False)
     return arr

@@ -243,7 +243,8 @@ def test_api_messages_show_plain_numbers():
          "times must be finite and strictly increasing: item 3 of 3 is 1.0, after 1.0"),
         (lambda: rsf.Protocol(np.array([0.0, 1.0]), np.array([1.0, -1.0])),
          "velocities must be finite and >= 0: item 2 of 2 is -1.0"),
-        (lambda: rsf.InitialState(perturbation=np.float64(-2.0)), "perturbation must be a finite number > -1, got -2.0"),
+        (lambda: rsf.InitialState(perturbation=np.float64(-2.0)),
+         "perturbation must be a finite number > -1, got -2.0"),
     ]
     for make, message in checks:
         with pytest.raises(ValueError) as exc:
@@ -317,3 +318,53 @@ def test_two_state_run_writes_theta2(tmp_path):
     # one state variable: the columns are unchanged
     assert main(["run", "--k0", "0.01", *log, "--steps", "1:10,3", "--t-end", "60", "--out", str(out)]) == 0
     assert list(pd.read_csv(out).columns) == ["t", "x", "sigma", "theta", "v"]
+
+
+# --- row 1: a long run over steady sliding finishes; one bound on t_end for API and CLI ------
+class _CountingRuns:
+    """Counts the CVODE runs (integrate / integrate_outputs calls) of the solver."""
+
+    def __init__(self, monkeypatch):
+        self.calls = 0
+        for name in ("integrate", "integrate_outputs"):
+            original = getattr(rsf.solver, name)
+            monkeypatch.setattr(rsf.solver, name, self._wrap(original))
+
+    def _wrap(self, original):
+        def counted(*args, **kwargs):
+            self.calls += 1
+            return original(*args, **kwargs)
+        return counted
+
+
+@pytest.mark.parametrize("law, steady", [("hyperbolic", 0.95 - 0.025 + 0.007 / 1.078), ("log", 0.6)])
+def test_long_run_across_steady_sliding_finishes(law, steady, tmp_path, monkeypatch):
+    # the issue's call: exit 3 after 20 s ("slide at t = 0 did not end", 100000 runs of CVODE)
+    # with the paper's law; with the log law CVODE's steps shrank to the noise of the steady
+    # state and the run did not end
+    runs = _CountingRuns(monkeypatch)
+    out = tmp_path / "o.csv"
+    # (a budget of 1e5 right-hand-side evaluations: the work is counted, and a regression
+    # fails in seconds with STEP_BUDGET instead of running for minutes)
+    assert main(["run", "--k0", "0.5", "--V", "1", "--law", law, "--t-end", "1e8", "--max-rhs-evals", "100000",
+                 "--out", str(out)]) == 0
+    series = pd.read_csv(out)
+    assert series.t.iloc[-1] == pytest.approx(1e8, rel=1e-12)
+    assert series.sigma.iloc[-1] == pytest.approx(steady, abs=1e-12)
+    assert runs.calls < 200 and len(series) < 5000
+
+
+def test_t_end_has_one_bound_for_api_and_cli(capsys):
+    from rsf import cli
+
+    assert rsf.params.T_END_MAX == cli.T_END_MAX == 1e8
+    model = rsf.SpringSlider(k0=0.5)
+    for t_end in (1e300, 2e8):
+        with pytest.raises(ValueError, match=r"t_end must be <= 1e\+08 \(rsf.params.T_END_MAX\), got"):
+            rsf.simulate(model, V=1.0, t_end=t_end)
+    with pytest.raises(ValueError, match=r"t_end must be a finite number > 0, got inf"):
+        rsf.simulate(model, V=1.0, t_end=float("inf"))
+    assert main(["run", "--k0", "0.5", "--V", "1", "--t-end", "2e8", "--out", "-"]) == 2
+    assert "--t-end must be in (0, 1e+08], got 2e+08" in _error_line(capsys)
+    assert "end time, in (0, 1e+08]" in " ".join(build_parser()._subparsers._group_actions[0]
+                                                 .choices["run"].format_help().split())
