@@ -84,3 +84,45 @@ def test_user_guide_code_runs_as_written(page, tmp_path, monkeypatch):
     namespace: dict = {}
     for i, block in enumerate(blocks):
         exec(compile(block, f"docs/guide/{page}.md, block {i + 1}", "exec"), namespace)
+    # and what it computes is right, against values computed independently here
+    if page == "rsf":
+        _check_rsf_guide_values(namespace)
+    else:
+        _check_micro_guide_values(namespace)
+
+
+def _check_rsf_guide_values(ns: dict) -> None:
+    # the paper law mu_ss = mu_inf + A/(v + B) at k0 = 0.1 (mu_inf = 1 - zbar kappa / 2 = 0.945):
+    # steady sliding is unstable where W(V) = A V/(V + B)^2 exceeds k0 Dc, i.e. between the
+    # roots of k0 Dc (V + B)^2 - A V (the guide says Vc = 1.0046, V_lower = 0.0061)
+    import numpy as np
+
+    model, cv, table = ns["model"], ns["cv"], ns["table"]
+    A, B, c = model.law.A, model.law.B, model.k0 * model.Dc
+    assert model.law.mu_ss(1.0) == pytest.approx(0.945 + A / (1.0 + B), rel=1e-14)
+    lower, upper = sorted(np.roots([c, 2.0 * c * B - A, c * B * B]).real)
+    assert cv.Vc == pytest.approx(upper, rel=1e-10) and cv.V_lower == pytest.approx(lower, rel=1e-10)
+    assert round(cv.Vc, 4) == 1.0046 and round(cv.V_lower, 4) == 0.0061
+    for V, regime, sigma in zip(table.V, table.regime, table.sigma_mean):
+        assert regime == ("steady" if V > upper or V < lower else "stick-slip"), V
+        if regime == "steady":
+            assert sigma == pytest.approx(0.945 + A / (V + B), rel=1e-12)
+
+
+def _check_micro_guide_values(ns: dict) -> None:
+    # the steady branch and V^c against tests/micro/_independent_renewal.py (shares no code
+    # with micro.renewal); the sweep's regimes on either side of V^c
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tests" / "micro"))
+    import _independent_renewal as IR
+
+    model, branch, table = ns["model"], ns["branch"], ns["table"]
+    for V, sigma in zip([0.5, 1.0, 2.0], branch.sigma):
+        assert sigma == pytest.approx(IR.steady(model, V).sigma, rel=1e-9)
+    vc = IR.critical_velocity(model)
+    assert round(vc, 11) == 0.72750434069  # the value the guide prints
+    for V, regime, sigma in zip(table.V, table.regime, table.sigma_mean):
+        assert regime == ("steady" if V > vc else "stick-slip"), V
+        if regime == "steady":
+            assert sigma == pytest.approx(IR.steady(model, V).sigma, rel=1e-9)
