@@ -335,7 +335,7 @@ def _run(args) -> int:
         return 0 if frame.converged.all() else 3
     if args.command == "sweep":
         velocities = _floats(args.V, "V", *V_RANGE)
-        method = {"auto": Auto(cohort=cohort), "cohort": cohort, "fp": "fp"}[args.method]
+        method = "fp" if args.method == "fp" else cohort if args.method == "cohort" else Auto(cohort=cohort)
 
         def row_done(frame: pd.DataFrame) -> None:
             # the CSV holds every row computed so far: a later row that fails, or a kill, loses nothing

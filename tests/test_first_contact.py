@@ -83,7 +83,7 @@ FORMAT = re.compile(r"^(DEBUG|INFO|WARNING|ERROR|CRITICAL) (micro|rsf|compare)(\
 
 @pytest.mark.parametrize("argv", [
     # an unconverged Fokker-Planck run (warns) and an unconverged RS limit cycle (warns)
-    ["micro", "sweep", "--k0", "0.3", "--V", "0.15", "--eps", "0.025", "--t-max", "2", "-v"],
+    ["micro", "sweep", "--k0", "0.3", "--V", "0.15", "--method", "fp", "--eps", "0.025", "--t-max", "2", "-v"],
     ["rsf", "-v", "sweep", "--k0", "0.3", "--V", "0.2029", "--max-cycles", "3", "--no-accelerate"],
 ])
 def test_log_lines_have_one_format(argv, tmp_path):
@@ -146,7 +146,7 @@ def test_micro_sweep_and_critical_report_each_point_as_it_finishes(tmp_path, cap
     assert main(["sweep", "--k0", "0.1", "--V", "2,5", "--out", str(tmp_path / "s.csv")]) == 0
     lines = capsys.readouterr().err.splitlines()
     # the first point's line carries an ETA for the rest; the last one none
-    assert re.match(r"^\[1/2, \d+ s, ETA \d+ s\] V=2: steady, sigma_max=0\.89", lines[0])
+    assert re.match(r"^\[1/2, \d+ s, ETA \d+ s\] V=2: steady \(renewal\), sigma_max=0\.89", lines[0])
     assert re.match(r"^\[2/2, \d+ s\] V=5", lines[1])
     assert main(["critical", "--k0", "0.3,0.1", "--out", str(tmp_path / "c.csv"), "-v"]) == 0
     lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("[")]

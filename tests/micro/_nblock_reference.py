@@ -12,7 +12,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from micro.nblock import NBlockState, Velocity, _check_int, _check_model, _segments
+from micro.nblock import NBlockState, Velocity, _check_int, _check_model, _segments, initial_state
 from micro.params import Model
 
 # ---------------------------------------------------------------------------------------

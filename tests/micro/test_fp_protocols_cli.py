@@ -39,12 +39,13 @@ def _cli(*args, cwd):
 
 def test_cli_sweep_and_run_write_the_documented_columns(tmp_path):
     out = tmp_path / "sweep.csv"
-    res = _cli("sweep", "--k0", "0.1", "--V", "0.05,2", "--eps", "0.02", "--out", str(out), cwd=tmp_path)
+    res = _cli("sweep", "--k0", "0.1", "--V", "0.05,2", "--out", str(out), cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     table = pd.read_csv(out)
-    for col in "k0,k1,k2,zbar,V,regime,sigma_max,sigma_min,sigma_mean".split(","):
+    for col in "k0,k1,k2,zbar,V,method,regime,sigma_max,sigma_min,sigma_mean,discretisation_error".split(","):
         assert col in table.columns
     assert list(table.regime) == ["stick-slip", "steady"]
+    assert list(table.method) == ["cohort", "renewal"]  # the default: each row by its best method
     steady = table.iloc[1]
     assert steady.sigma_max == steady.sigma_min == steady.sigma_mean
     assert steady.sigma_mean == pytest.approx(0.893759123072792, abs=1e-10)  # the exact steady state
@@ -173,7 +174,7 @@ def test_cli_run_slide_hold_slide_and_constant_velocity(tmp_path):
     (["run", "--k0", "0.3", "--shs", "1", "1e12", "10", "20"], r"--shs SLIDE must be in \(0, 1e\+08\]"),
     (["run", "--k0", "0.3", "--schedule", "1:1e12"], r"--schedule item 1 duration must be in \(0, 1e\+08\]"),
     (["run", "--k0", "0.3", "--schedule", "1:10,nan:5"], r"--schedule item 2 velocity must be in \[0, 1e\+07\]"),
-    (["sweep", "--k0", "0.1", "--V", "1", "--t-max", "1e300"], r"--t-max must be in \(0, 1e\+08\]"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--method", "fp", "--t-max", "1e300"], r"--t-max must be in \(0, 1e\+08\]"),
 ])
 def test_every_input_is_checked_before_computing(argv, match, tmp_path, capsys):
     # each of these used to compute first (sweep --V 5,nan: 228 s) and fail on writing or on
