@@ -283,7 +283,7 @@ def _options(args, models: list[Model]):
     cohort_used = args.command == "sweep"
     if args.command == "sweep":
         if args.method in RETIRED:
-            raise ValueError(f"--method cycle was retired (its cycles are wrong close to V^c): use --method cohort, "
+            raise ValueError("--method cycle was retired (its cycles are wrong close to V^c): use --method cohort, "
                              "or auto (the default), which solves the same stick-slip cycles at every k0")
         if args.method not in ("auto", "cohort", "fp"):
             raise ValueError(f"--method must be auto, cohort or fp, got {args.method!r}")
