@@ -186,8 +186,13 @@ def test_anderson_leaves_the_plain_cycles_half_the_budget():
     V = 0.95 * micro.critical_velocity(model).Vc
     res = cycle_cohorts(model, V, dt=0.04, h=model.kappa * model.zbar / 5, tol=1e-9, max_iter=60,
                         start=_NO_COARSE)
-    assert "Anderson" in res.message or not res.converged
-    assert res.iterations <= 60 and len(res.history) >= 20
+    # (was: '"Anderson" in res.message or not res.converged', true either way.)  What happens:
+    # Anderson runs (accelerated), takes at most half of the cycles left after the first
+    # window, the plain cycles get the rest (27 measured after it, the history it leaves),
+    # and 60 cycles do not reach 1e-9, which the run says
+    assert res.accelerated and not res.converged
+    assert res.message.startswith("no fixed point to 1e-09 in 60 cycles"), res.message
+    assert res.iterations == 60 and len(res.history) >= 25
     assert math.isfinite(res.sigma_max) and res.sigma_max == pytest.approx(0.9068, abs=1e-3)
 
 

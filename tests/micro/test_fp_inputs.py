@@ -33,7 +33,14 @@ def test_model_rejects_bad_parameters(kwargs, match):
         (lambda: micro.Exponential(0.0), r"zbar"),
         (lambda: micro.Exponential(0.1, cutoff=0.0), r"cutoff"),
         (lambda: micro.Deterministic(-0.1), r"zbar"),
-        (lambda: micro.Tabulated(np.array([0.0, 1.0]), np.array([1.0, -1.0])), r"."),
+        # (was one case matching r"." -- any message -- that passed arrays where a callable pdf goes)
+        (lambda: micro.Tabulated(np.array([0.0, 1.0]), 1.0), r"pdf must be a callable"),
+        (lambda: micro.Tabulated(pdf=lambda z: 1.0 - 2.0 * z, support_max=1.0),
+         r"pdf must be finite and >= 0 on \[0, support_max\]"),
+        (lambda: micro.Tabulated(pdf=lambda z: np.zeros_like(z), support_max=1.0), r"pdf must have positive mass"),
+        (lambda: micro.Tabulated(pdf=lambda z: 1.0, support_max=1.0), r"pdf must return an array of the same shape"),
+        (lambda: micro.Tabulated(pdf=np.ones_like, support_max=0.0), r"support_max must be a finite number > 0"),
+        (lambda: micro.Tabulated(pdf=np.ones_like, support_max=1.0, n=5), r"n must be an integer >= 17"),
     ],
 )
 def test_jump_distributions_reject_bad_parameters(make, match):

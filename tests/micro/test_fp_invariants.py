@@ -193,11 +193,13 @@ def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state(caplo
     assert f"{len(missed)} of {len(crit.evaluations)} runs did not converge" in warnings[0]
     assert all(f"{V:.4g}" in warnings[0] for V in missed)
     assert crit.status == "converged" and crit.V_low < crit.Vc < crit.V_high
-    # against the exact V^c (direct method, 0.7275): the velocity called steady is above it and
-    # the bracket within 30 % (measured 0.816-0.904: the coarse bin's own cycle, which the
-    # check at eps / 2 skipped here removes; an FP that got better still passes)
+    # against the exact V^c (direct method, 0.7275): the velocity called steady is above it.
+    # The bisection visits 1, 0.667, 0.8165, 0.9036 and at this coarse bin labels 0.8165
+    # stick-slip (the bin's own cycle, which the check at eps / 2, skipped here, removes):
+    # bracket 0.816-0.904, V^c 0.859 = 1.18 exact (was allowed 1.3).  One label better
+    # (0.8165 steady) gives 1.01; one worse (0.9036 stick-slip) gives 1.31 and fails
     exact = micro.critical_velocity(model).Vc
-    assert crit.V_high > exact and crit.Vc < 1.3 * exact
+    assert crit.V_high > exact and crit.Vc < 1.2 * exact
     evals = pd.DataFrame(crit.evaluations)
     slowest = math.inf
     for e in evals.itertuples():
