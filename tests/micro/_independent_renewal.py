@@ -86,7 +86,7 @@ from scipy import integrate, optimize
 
 import micro
 
-__all__ = ["Resolution", "JumpLaw", "jump_law", "steady", "branching_ratio", "critical_velocity",
+__all__ = ["Resolution", "JumpLaw", "jump_law", "steady", "branching_ratio", "branching_excess", "critical_velocity",
            "deterministic_steady", "deterministic_critical_velocity"]
 
 
