@@ -30,11 +30,11 @@ __all__ = ["FP", "Numerics", "Cohort", "Renewal", "Auto", "Convergence", "METHOD
            "check_velocity"]
 
 
-def _no_bool(obj, names) -> None:
+def _no_bool(obj, names, prefix: str = "") -> None:
     """Numbers only: a bool (``True`` is an int to Python) is refused, naming the field."""
     for name in names:
         if isinstance(getattr(obj, name), bool):
-            raise ValueError(f"{name} must be a number, got {getattr(obj, name)!r}")
+            raise ValueError(f"{prefix}{name} must be a number, got {getattr(obj, name)!r}")
 
 
 def check_velocity(V: float, name: str = "V") -> float:
@@ -162,7 +162,7 @@ class Cohort:
     max_iter: int = 200
 
     def __post_init__(self) -> None:
-        _no_bool(self, ("dt", "h", "tol", "max_iter"))
+        _no_bool(self, ("dt", "h", "tol", "max_iter"), "Cohort ")
         if not (isinstance(self.tol, (int, float)) and math.isfinite(self.tol) and 1e-9 <= self.tol <= 1e-2):
             raise ValueError(f"Cohort tol must be in [1e-9, 1e-2], got {self.tol!r}")
         if not (isinstance(self.dt, (int, float)) and math.isfinite(self.dt) and 0.0 < self.dt <= 0.1):
@@ -195,7 +195,7 @@ class Renewal:
     tol: float = 1e-11
 
     def __post_init__(self) -> None:
-        _no_bool(self, ("tol",))
+        _no_bool(self, ("tol",), "Renewal ")
         if not (isinstance(self.tol, (int, float)) and math.isfinite(self.tol) and 1e-13 <= self.tol <= 1e-3):
             raise ValueError(f"Renewal tol must be in [1e-13, 1e-3], got {self.tol!r}")
 

@@ -30,16 +30,35 @@ def _require(condition: bool, message: str) -> None:
         raise ValueError(message)
 
 
-def _finite_positive(name: str, value: float) -> float:
-    value = float(value)
-    _require(math.isfinite(value) and value > 0.0, f"{name} must be a finite number > 0, got {value!r}")
+def _number(name: str, value) -> float:
+    """``value`` as a float, or one ValueError naming it: a bool (an int to Python) or a
+    string is not a number here."""
+    if isinstance(value, (bool, str, bytes)) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    return float(value)
+
+
+def _finite_positive(name: str, value: float, high: float = math.inf) -> float:
+    value = _number(name, value)
+    if high < math.inf:
+        _require(math.isfinite(value) and 0.0 < value <= high, f"{name} must be in (0, {high:g}], got {value:g}")
+    _require(math.isfinite(value) and value > 0.0, f"{name} must be a finite number > 0, got {value:g}")
     return value
 
 
-def _finite_nonnegative(name: str, value: float) -> float:
-    value = float(value)
-    _require(math.isfinite(value) and value >= 0.0, f"{name} must be a finite number >= 0, got {value!r}")
+def _finite_nonnegative(name: str, value: float, high: float = math.inf) -> float:
+    value = _number(name, value)
+    if high < math.inf:
+        _require(math.isfinite(value) and 0.0 <= value <= high, f"{name} must be in [0, {high:g}], got {value:g}")
+    _require(math.isfinite(value) and value >= 0.0, f"{name} must be a finite number >= 0, got {value:g}")
     return value
+
+
+#: Largest stiffness a Model accepts, in units of the threshold over a mean jump (f_th /
+#: zbar = 10 for the paper's parameters): beyond it a mean jump changes the stress by more
+#: than a thousand thresholds and every stress loses its meaning (k0 = 1e300 gave
+#: sigma = -1e299 with converged=True).
+STIFFNESS_MAX = 1e3
 
 
 class JumpDistribution:
@@ -232,9 +251,9 @@ class Model:
 
     Parameters
     ----------
-    k0 : driving-spring stiffness, > 0.
-    k1 : elastic coupling between blocks, >= 0.
-    k2 : stiffness of the viscoelastic (spring + dashpot) coupling, >= 0.
+    k0 : driving-spring stiffness, in (0, 1e3 f_th / zbar] (1e4 for the paper's parameters).
+    k1 : elastic coupling between blocks, in [0, 1e3 f_th / zbar].
+    k2 : stiffness of the viscoelastic (spring + dashpot) coupling, in [0, 1e3 f_th / zbar].
     eta_u : dashpot viscosity, > 0; the relaxation rate is ``gamma = k2 / eta_u``.
     f_th : pinning threshold, > 0.
     jumps : distribution of pinning distances; default exponential with mean 0.1 and
@@ -249,15 +268,16 @@ class Model:
     jumps: JumpDistribution = field(default_factory=lambda: Exponential(0.1, 10.0))
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "k0", _finite_positive("k0", self.k0))
-        object.__setattr__(self, "k1", _finite_nonnegative("k1", self.k1))
-        object.__setattr__(self, "k2", _finite_nonnegative("k2", self.k2))
-        object.__setattr__(self, "eta_u", _finite_positive("eta_u", self.eta_u))
-        object.__setattr__(self, "f_th", _finite_positive("f_th", self.f_th))
         _require(
             isinstance(self.jumps, JumpDistribution),
             f"jumps must be a JumpDistribution (Exponential, Deterministic or Tabulated), got {type(self.jumps).__name__}",
         )
+        object.__setattr__(self, "f_th", _finite_positive("f_th", self.f_th))
+        top = STIFFNESS_MAX * self.f_th / float(self.jumps.mean)
+        object.__setattr__(self, "k0", _finite_positive("k0", self.k0, top))
+        object.__setattr__(self, "k1", _finite_nonnegative("k1", self.k1, top))
+        object.__setattr__(self, "k2", _finite_nonnegative("k2", self.k2, top))
+        object.__setattr__(self, "eta_u", _finite_positive("eta_u", self.eta_u))
 
     @property
     def kappa(self) -> float:

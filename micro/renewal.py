@@ -444,8 +444,18 @@ class SteadySliding:
         })
 
 
+#: A dashpot whose stiffness is below this fraction of kappa is taken as absent: its effect
+#: on sigma and b is of order k2 / kappa, and the chain's solve with it is singular
+#: (k2 = 2e-211 at k0 = 1: numpy.linalg.LinAlgError, found by tests/micro/test_properties.py).
+NO_DASHPOT = 1e-13
+
+
+#: Smallest relaxation per mean wait, gamma zbar / V, the chain resolves.
+RELAX_MIN = 1e-16
+
+
 def _no_dashpot(model: Model) -> bool:
-    return model.k2 == 0.0
+    return model.k2 <= NO_DASHPOT * model.kappa
 
 
 def steady_sliding(model: Model, V, *, tol: float = 1e-11, growth_rate: bool = True,
@@ -463,6 +473,11 @@ def steady_sliding(model: Model, V, *, tol: float = 1e-11, growth_rate: bool = T
     v = _check_velocities(V)
     if not (math.isfinite(tol) and tol > 0.0):
         raise ValueError(f"tol must be a finite number > 0, got {tol!r}")
+    if not _no_dashpot(model) and model.gamma * model.jumps.mean / float(np.max(v)) < RELAX_MIN:
+        # (the chain's solve is singular where exp(-gamma t) rounds to 1 over a wait: k2 = 1e-11, V = 1e6)
+        raise ValueError(f"V must be at most gamma zbar / {RELAX_MIN:g} = {model.gamma * model.jumps.mean / RELAX_MIN:g} "
+                         f"for this model: faster, the dashpots relax by less than round-off between a block's "
+                         f"jumps and the renewal chain cannot resolve them, got {float(np.max(v)):g}")
     flat = v.ravel()
     out = {k: np.full(flat.size, math.nan) for k in ("sigma", "b", "lam", "err_s", "err_b", "wait", "n")}
     conv = np.ones(flat.size, dtype=bool)
