@@ -32,6 +32,8 @@ from typing import Any, Iterable, Iterator, Sequence
 
 from tqdm.auto import tqdm
 
+from micro._threads import available_cores
+
 from ._validation import positive_int
 from .cache import NullCache, PointCache
 from .tasks import Task, execute, warm_up
@@ -71,10 +73,15 @@ _THREADS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA
 
 def _worker_init(parent_pid: int) -> None:
     """A pool worker: Ctrl-C is the parent's to handle (it stops the pool at once), and the
-    worker dies with its parent however the parent ends (SIGKILL included)."""
+    worker dies with its parent however the parent ends (SIGKILL included).  It runs
+    numba's kernels and BLAS on one thread (the workers already fill the cores): the
+    environment it was started with says so, and so does micro, whatever the environment."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _die_with_parent(parent_pid)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    from micro._threads import single_thread_process
+
+    single_thread_process()
     warm_up()
 
 
@@ -127,7 +134,8 @@ class Runner:
     cache : PointCache, NullCache or None
         Where records live; None means a :class:`PointCache` in the default directory.
     workers : int or None
-        Local processes (None: ``os.cpu_count()``); 1 runs the tasks in this process.
+        Local processes (None: the processors this process may run on, its affinity
+        mask); 1 runs the tasks in this process.  Each worker runs on one thread.
         Ignored when ``scheduler`` is given.
     scheduler : str or distributed.Client or None
         Address of a dask.distributed scheduler (needs the optional ``dask`` extra).
@@ -142,7 +150,7 @@ class Runner:
         self.cache = PointCache() if cache is None else cache
         if not isinstance(self.cache, (PointCache, NullCache)):
             raise ValueError(f"cache must be a PointCache or NullCache, got {type(self.cache).__name__}")
-        self.workers = (os.cpu_count() or 1) if workers is None else positive_int("workers", workers)
+        self.workers = available_cores() if workers is None else positive_int("workers", workers)
         if scheduler is not None and not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
             raise ValueError(f"scheduler must be an address like 'tcp://host:8786' or a distributed.Client, "
                              f"got {scheduler!r}")

@@ -11,11 +11,21 @@ there.  ``co[c]`` holds the step's coefficients: beta (the margin's response to 
 at birth, aged by ``a`` more than the rest), the threshold ``D``
 at delta_R = 0, dD/d(delta_R), dD/d(dX), exp(-gamma age), and the smallest gap between
 floor and threshold at dX = 0 (cohorts that cannot cross are skipped).
+
+Threads: :func:`closure`, :func:`smallest_root` and :func:`commit` are called from Python;
+each first sets numba's thread count to the cores free to this process
+(:func:`micro._threads.use_free_cores`: serial beside other busy processes, where
+numba's OpenMP threads spun at every join and made two runs at once on 2 cores 6 to 60
+times slower each).  Jitted code calls the kernels ``_closure``, ``_smallest_root`` and
+``_commit`` directly.
 """
+import functools
 import math
 
 import numpy as np
 from numba import njit, prange
+
+from ._threads import use_free_cores
 
 #: The cohorts are summed in this many interleaved chunks (the order of the sums does not
 #: depend on the number of threads), in parallel from PARALLEL_COHORTS cohorts on.
@@ -214,7 +224,7 @@ def _closure_cohort(c, dX, co, j0, nn, off, q, m, ylo, h, lam):
 
 
 @njit(cache=True, parallel=True)
-def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar):
+def _closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar):
     """H(dX) = zbar * (jumps per block in the step if the slip is dX) - dX, and dH/d(dX).
     First crossings are integrated exactly over each cell's crossed part; a block that
     crossed jumps again as a Poisson process of rate 1/lam in its margin's overshoot
@@ -247,7 +257,7 @@ def closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar):
 
 
 @njit(cache=True)
-def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, tol, xmin, xguess):
+def _smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, tol, xmin, xguess):
     """The smallest root of H (status 0), or status 1 if H has a positive local minimum
     before it: the slip jumps, a fold (the start of a shock).  Newton from 0 with steps
     capped at doubling (from ``xmin``) so that a minimum is not jumped over, then
@@ -261,11 +271,11 @@ def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, tol, xmin, xguess
     x = 0.0
     H, dH = -1.0, 0.0
     if xguess > 0.0:
-        H, dH = closure(xguess, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+        H, dH = _closure(xguess, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
         if H > 0.0 and dH < 0.0:
             x = xguess
     if x == 0.0:
-        H, dH = closure(x, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+        H, dH = _closure(x, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
         if H <= 0.0:
             return 0.0, 0
     for it in range(400):
@@ -277,7 +287,7 @@ def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, tol, xmin, xguess
         cap = 2.0 * x + xmin
         if xn > cap:
             xn = cap
-        Hn, dHn = closure(xn, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+        Hn, dHn = _closure(xn, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
         if Hn > 0.0:
             x, H, dH = xn, Hn, dHn
             continue
@@ -292,7 +302,7 @@ def smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, tol, xmin, xguess
                 # Newton from the left (H is convex here, so it stays left of the root
                 # and b never moves): converged to round-off
                 return xt, 0
-            Ht, dHt = closure(xt, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+            Ht, dHt = _closure(xt, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
             if Ht > 0.0:
                 a, Ha, dHa = xt, Ht, dHt
             else:
@@ -418,7 +428,7 @@ def _commit_cohort(c, dX, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h,
 
 
 @njit(cache=True, parallel=True)
-def commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2, kappa, f_th, gx, gw, dep):
+def _commit(dX, n, co, j0, nn, off, q, m, J, X0, s0, X, Edt, phi, ylo, h, lam, k2, kappa, f_th, gx, gw, dep):
     """Apply a step of slip ``dX``: the crossed members' delta_R (a linear function of
     their margin at birth, so an exponential on a segment) is deposited exactly on the
     hat functions of the nodes ``ylo + j h`` (``dep``: the newborn cohort, margins
@@ -557,3 +567,21 @@ def compact(n, j0, nn, off, q, m, cell, floor, keep, q_out, m_out):
         p += b - a
         i += 1
     return i, p, dropped
+
+
+# ------------------------------------------------------------------------------ entry points from Python
+def _on_free_cores(kernel):
+    """``kernel`` (jitted) run with the calling thread's numba thread count set to the
+    cores free now (:func:`micro._threads.use_free_cores`)."""
+
+    @functools.wraps(kernel, updated=())
+    def call(*args):
+        use_free_cores()
+        return kernel(*args)
+
+    return call
+
+
+closure = _on_free_cores(_closure)
+smallest_root = _on_free_cores(_smallest_root)
+commit = _on_free_cores(_commit)

@@ -29,6 +29,12 @@ affine map, or a sinh map clustered at x = 0 on the scale (k0 + k1)/k2 when that
 small, and composite Gauss-Legendre in z, graded towards z = 0.  The stationary weights are quadrature weights
 (they may be negative), not a density.  Deterministic jumps have no density: the chain is
 a 1-D map whose fixed point Newton's method finds (it reproduces Eq. (4)).
+
+Threads: the systems are small (32 to 384 unknowns) and solved thousands of times in a
+growth-rate root, where multithreaded BLAS gains nothing and its waiting threads spin
+against other work (``steady_sliding(Model(k0=0.1), np.logspace(-1, 3, 100))``: 1.2 s
+alone, 101 s under a load of 4).  Every public function here runs with BLAS held at one
+thread (:func:`micro._threads.single_blas_thread`), the previous limits restored after.
 """
 from __future__ import annotations
 
@@ -42,6 +48,7 @@ from numpy.polynomial.legendre import leggauss
 from scipy.optimize import brentq
 
 from . import _renewal_kernels as RK
+from ._threads import blas_single_threaded
 from .analytic import _check_model
 from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
 
@@ -334,6 +341,7 @@ def _gain(model: Model, V: float, tol: float):
     return gain
 
 
+@blas_single_threaded
 def characteristic_function(model: Model, V: float, lam, *, tol: float = 1e-10) -> np.ndarray:
     r"""The open-loop gain :math:`G(\lambda)` of steady sliding at drive velocity V.
 
@@ -381,6 +389,7 @@ def _growth_rate(model: Model, V: float, b: float, tol: float) -> float:
     return model.gamma * math.exp(brentq(f, lo, hi, xtol=1e-12))
 
 
+@blas_single_threaded
 def unstable_mode_count(model: Model, V: float, *, omega_max: float | None = None, n_omega: int = 4000,
                         tol: float = 1e-10) -> int:
     r"""The number of roots of :math:`G(\lambda) = 1` with :math:`\operatorname{Re}\lambda > 0`,
@@ -458,6 +467,7 @@ def _no_dashpot(model: Model) -> bool:
     return model.k2 <= NO_DASHPOT * model.kappa
 
 
+@blas_single_threaded
 def steady_sliding(model: Model, V, *, tol: float = 1e-11, growth_rate: bool = True,
                    warn: bool = True) -> SteadySliding:
     """Steady sliding at drive velocity ``V`` (a number or an array), on either branch.
@@ -522,6 +532,7 @@ def vc_small_k0(model: Model) -> float:
     return model.k2 * model.gamma * model.jumps.mean_residual / model.k0
 
 
+@blas_single_threaded
 def critical_velocity_renewal(model: Model, *, V_min: float = 1e-4, V_max: float = 1e5, rtol: float = 1e-10,
                               tol: float = 1e-11):
     """V^c as the root of ``b(V) = 1``, the velocity where the branching ratio of steady

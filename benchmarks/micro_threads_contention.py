@@ -1,0 +1,172 @@
+"""k copies of one micro computation at once: does each cost at most about k times one alone?
+
+Two workloads, each in its own process, ``k`` = 1, 2, 3 of them started together:
+
+* ``cohort``: ``micro.stationary(micro.Model(k0=0.01), 4.0, method="cohort")``, a stick-slip
+  cycle by the cohort method (numba's parallel kernels, issue 39 row 13);
+* ``renewal``: ``micro.steady_sliding(micro.Model(k0=0.1), np.logspace(-1, 3, 100))``, the
+  steady branch with growth rates (thousands of small BLAS solves, row 6).
+
+Compilation is apart: one process first runs each workload once (it fills numba's disk
+cache; its time is the ``compile`` row).  Then each copy imports micro, says it is ready,
+and waits; when all ``k`` are ready they are released at once and each times the call
+alone (wall and CPU seconds: loading the kernels from the disk cache, a fraction of a
+second, is in it, as in any run).  The machine's load is written beside each batch: the
+1-minute load average when the batch starts and ends, and how many threads of other
+processes were running or waiting for a processor as it started (``others_runnable``).
+Batches go ``k`` = 1, 2, 3, 1, 2, 3, ... so that a drift of the background load spreads
+over all ``k``.
+
+    python benchmarks/micro_threads_contention.py --label after            # about 2 minutes alone
+    python benchmarks/micro_threads_contention.py --label before --append  # with an older micro first on PYTHONPATH
+
+The copies import whichever ``micro`` their environment finds, so a ``before`` run is
+this script with an older checkout first on ``PYTHONPATH``.  Rows go to
+``benchmarks/results/micro_threads_contention.csv`` (``--append`` keeps the rows of
+other labels).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+
+OUT = Path(__file__).resolve().parent / "results" / "micro_threads_contention.csv"
+
+WORKLOADS = {
+    "cohort": 'micro.stationary(micro.Model(k0=0.01), 4.0, method="cohort")',
+    "renewal": "micro.steady_sliding(micro.Model(k0=0.1), np.logspace(-1, 3, 100))",
+}
+
+CHILD = r"""
+import json, os, sys, time
+t0 = time.perf_counter()
+import numpy as np
+import micro
+import numba
+t1 = time.perf_counter()
+print(json.dumps({"ready": True, "import_s": t1 - t0}), flush=True)
+if sys.stdin.readline().strip() != "go":
+    sys.exit(1)
+c0, w0 = time.process_time(), time.perf_counter()
+CALL
+w1, c1 = time.perf_counter(), time.process_time()
+print(json.dumps({"wall_s": w1 - w0, "cpu_s": c1 - c0, "import_s": t1 - t0,
+                  "micro": os.path.dirname(micro.__file__), "numba_threads_after": numba.get_num_threads()}),
+      flush=True)
+"""
+
+
+def _load() -> tuple[float, int]:
+    """The 1-minute load average, and the threads of other processes running or waiting
+    for a processor now (the machine's runnable count less this one; Linux)."""
+    try:
+        with open("/proc/loadavg") as f:
+            fields = f.read().split()
+        return float(fields[0]), int(fields[3].split("/")[0]) - 1
+    except (OSError, ValueError, IndexError):
+        return os.getloadavg()[0], -1
+
+
+def batch(workload: str, k: int, timeout: float) -> list[dict]:
+    """``k`` copies of ``workload`` released together; a dict per copy."""
+    code = CHILD.replace("CALL", WORKLOADS[workload])
+    procs = [subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                              text=True) for _ in range(k)]
+    try:
+        for p in procs:
+            line = p.stdout.readline()
+            if not line or not json.loads(line).get("ready"):
+                raise RuntimeError(f"a copy of {workload} did not start (exit {p.wait()})")
+        load1, runnable = _load()
+        for p in procs:
+            p.stdin.write("go\n")
+            p.stdin.flush()
+        rows = []
+        deadline = time.monotonic() + timeout
+        for i, p in enumerate(procs):
+            out, _ = p.communicate(timeout=max(1.0, deadline - time.monotonic()))
+            rec = json.loads(out.strip().splitlines()[-1])
+            rows.append({"workload": workload, "k": k, "copy": i + 1, "phase": "run", "wall_s": rec["wall_s"],
+                         "cpu_s": rec["cpu_s"], "numba_threads_after": rec["numba_threads_after"],
+                         "load1_start": load1, "others_runnable": runnable, "micro": rec["micro"]})
+        load1_end, _ = _load()
+        for r in rows:
+            r["load1_end"] = load1_end
+        return rows
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+
+
+def compile_once(workload: str) -> dict:
+    """One process runs ``workload`` once: numba compiles what its disk cache lacks."""
+    load1, runnable = _load()
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-c", f"import numpy as np, micro; {WORKLOADS[workload]}"], check=True)
+    return {"workload": workload, "k": 1, "copy": 1, "phase": "compile", "wall_s": time.perf_counter() - start,
+            "load1_start": load1, "others_runnable": runnable, "load1_end": _load()[0]}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--label", required=True, help="what is measured, e.g. 'before' or 'after'")
+    ap.add_argument("--k", default="1,2,3", help="numbers of copies at once (default 1,2,3)")
+    ap.add_argument("--repeats", type=int, default=3, help="batches of each k (default 3)")
+    ap.add_argument("--workloads", default="cohort,renewal", help="of: " + ", ".join(WORKLOADS))
+    ap.add_argument("--timeout", type=float, default=900.0, help="seconds for one batch (default 900)")
+    ap.add_argument("--out", type=Path, default=OUT)
+    ap.add_argument("--append", action="store_true", help="keep the rows of other labels in --out")
+    args = ap.parse_args()
+    ks = [int(x) for x in args.k.split(",")]
+    workloads = args.workloads.split(",")
+    for w in workloads:
+        if w not in WORKLOADS:
+            ap.error(f"--workloads: unknown {w!r} (known: {', '.join(WORKLOADS)})")
+    rows: list[dict] = []
+    for w in workloads:
+        rows.append(compile_once(w))
+        print(f"{w}: compile and first run {rows[-1]['wall_s']:.1f} s", flush=True)
+        for rep in range(1, args.repeats + 1):
+            for k in ks:
+                got = batch(w, k, args.timeout)
+                for r in got:
+                    r["repeat"] = rep
+                rows += got
+                print(f"{w} k={k} repeat {rep}: " + ", ".join(f"{r['wall_s']:.2f}" for r in got)
+                      + f" s (load {got[0]['load1_start']:.2f}, {got[0]['others_runnable']} other threads runnable)",
+                      flush=True)
+    frame = pd.DataFrame(rows).reindex(columns=["workload", "phase", "k", "repeat", "copy", "wall_s", "cpu_s",
+                                                "load1_start", "load1_end", "others_runnable",
+                                                "numba_threads_after", "micro"])
+    frame.insert(0, "label", args.label)
+    frame.insert(1, "date", time.strftime("%Y-%m-%d %H:%M"))
+    if args.append and args.out.exists():
+        old = pd.read_csv(args.out)
+        frame = pd.concat([old[old["label"] != args.label], frame], ignore_index=True)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(args.out, index=False)
+    # the verdict: the median wall time of a copy at k at once, against k times one alone
+    runs = frame[(frame["label"] == args.label) & (frame["phase"] == "run")]
+    for w in workloads:
+        sub = runs[runs["workload"] == w]
+        one = statistics.median(sub[sub["k"] == 1]["wall_s"]) if (sub["k"] == 1).any() else float("nan")
+        for k in ks:
+            wall = sub[sub["k"] == k]["wall_s"]
+            med = statistics.median(wall)
+            print(f"{args.label} {w}: k={k} median {med:.2f} s per copy (min {wall.min():.2f}, max {wall.max():.2f}),"
+                  f" {med / one:.2f} x one alone (target <= {k})")
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
