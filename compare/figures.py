@@ -2,7 +2,9 @@
 
 Conventions: a computed point is a marker (open when its run did not converge), a line
 is either exact (micro's steady branch, RS) or a fitted law, and what was not computed is
-marked as such.  Called by :func:`compare.report` with the computed tables.
+marked as such.  Each function draws one figure from a report's tables; the scenarios
+(:mod:`compare.scenarios`) and the shared stages (:class:`compare.context.Context`) call
+them.
 """
 from __future__ import annotations
 
@@ -19,7 +21,7 @@ import pandas as pd  # noqa: E402
 
 from . import fits  # noqa: E402
 
-__all__ = ["draw"]
+__all__ = ["target"]
 
 _COLORS = {0.3: "C0", 0.1: "C1", 0.01: "C2", 0.001: "C3", 0.0001: "C4"}
 
@@ -328,28 +330,7 @@ def fig10(t: dict[str, pd.DataFrame], path: Path) -> Path:
     return _save(fig, path)
 
 
-def draw(study, out) -> dict[str, Path]:
-    """Every figure whose tables the study computed, into the folder ``out`` (a path or a
-    :class:`~compare.output.ReportFolder`, which writes atomically); returns name -> path."""
-    t, v = study.tables, study.values
-    dest = (lambda name: (out, name)) if hasattr(out, "write") else (lambda name: Path(out) / name)  # noqa: E731
-    figs: dict[str, Path] = {}
-    if "rs_bifurcation" in t:
-        figs["bifurcation"] = bifurcation(t, study.Dc, study.s.fp_k0, dest("bifurcation.png"))
-    if "steady_fit_checks" in t:
-        figs["steady_fit"] = steady_fit(t, v, dest("steady_fit.png"))
-    if "dc_profile" in t:
-        figs["dc_profile"] = dc_profile(t, v, dest("dc_profile.png"))
-    if "vc_curves" in t:
-        figs["critical_velocity"] = critical_velocity(t, v, dest("critical_velocity.png"))
-    if "hopf_points" in t:
-        figs["hopf"] = hopf(t, v, dest("hopf.png"))
-    if "phase_rs" in t and len(t["phase_laws"]):
-        figs["phase"] = phase(t, v, dest("phase.png"))
-    if "shs_points" in t:
-        figs["shs"] = shs(t, dest("shs.png"))
-    if "fig3_traces" in t:
-        figs["fig3"] = fig3(t, dest("fig3.png"))
-    if "fig10_eps" in t:
-        figs["fig10"] = fig10(t, dest("fig10.png"))
-    return figs
+def target(out, name: str):
+    """Where a figure ``name`` goes in the folder ``out``: a
+    :class:`~compare.output.ReportFolder` (written atomically) or a plain path."""
+    return (out, name) if hasattr(out, "write") else Path(out) / name
