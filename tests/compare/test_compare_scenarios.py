@@ -1,0 +1,49 @@
+"""The report's layout: a registry of scenario modules on a shared context, each model built
+once; a new scenario is one module and one registry line."""
+from __future__ import annotations
+
+import importlib
+from collections import Counter
+from types import SimpleNamespace
+
+import pandas as pd
+
+import compare
+from compare.scenarios import Part
+
+report_module = importlib.import_module("compare.report")
+
+INTERFACE = ("NAME", "wanted", "vc_k0", "tasks", "run", "draw", "summary")
+
+
+def test_every_scenario_of_the_settings_is_a_registered_module():
+    names = [sc.NAME for sc in report_module.REGISTRY]
+    assert len(set(names)) == len(names)
+    assert set(compare.SCENARIOS) <= set(names)
+    for sc in report_module.REGISTRY:
+        assert all(hasattr(sc, attr) for attr in INTERFACE), sc.__name__
+
+
+def test_a_registered_scenario_joins_the_report_and_models_are_built_once(quick_report, tmp_path, monkeypatch):
+    _, cache = quick_report
+    toy = SimpleNamespace(
+        NAME="toy", wanted=lambda s: True, vc_k0=lambda ctx: [ctx.s.shs_k0], tasks=lambda ctx: [],
+        run=lambda ctx: Part(tables={"toy": pd.DataFrame({"k0": [ctx.s.shs_k0], "Vc": [ctx.Vc(ctx.s.shs_k0)]})},
+                             values={"toy": 1}),
+        draw=lambda ctx, part, out: {}, summary=lambda ctx, part: ["## Toy", "", "a paragraph", ""])
+    monkeypatch.setattr(report_module, "REGISTRY", report_module.REGISTRY + (toy,))
+    settings = compare.Settings.quick(scenarios=("shs",))   # (its validation builds models of its own)
+    built = Counter()
+    model = compare.Settings.model
+
+    def counting(self, k0, k1=None, k2=None):
+        built[(float(k0), self.k1 if k1 is None else k1, self.k2 if k2 is None else k2)] += 1
+        return model(self, k0, k1, k2)
+    monkeypatch.setattr(compare.Settings, "model", counting)
+
+    rep = compare.report(settings, Dc=0.06, out=tmp_path / "r", cache_dir=cache, workers=1, progress=False)
+    assert rep.stats.computed == 0   # every task of the shs scenario is in the quick report's cache
+    assert rep["toy"].Vc.iloc[0] > 0 and rep.values["toy"] == 1
+    assert (tmp_path / "r" / "toy.csv").exists()
+    assert rep.summary.index("## Slide-hold-slide") < rep.summary.index("## Toy\n\na paragraph")
+    assert built and max(built.values()) == 1, built.most_common(3)
