@@ -308,6 +308,29 @@ class Context:
         return fit
 
     @cached_property
+    def dc_per_k0(self) -> pd.DataFrame:
+        """D_c (a) fitted at each k0 of ``fp_k0`` alone (its stick-slip and steady points),
+        beside D_c (b) at that k0 (the fitted law's slope at micro's exact V^c): how far one
+        D_c is from carrying every k0.  Columns ``k0, n_points, Dc_a, Dc_a_lo, Dc_a_hi``
+        (the profile interval), ``rms_a``, ``Dc_b``, ``ratio_a_b``."""
+        pts = self.micro_points
+        per_b = self.dc_critical.per_k0.set_index("k0").Dc_law
+        rows = []
+        for k0, grp in pts.groupby("k0", sort=False):
+            try:
+                fit = fits.fit_dc(grp, self.law_for, bounds=self.s.dc_bounds, n_grid=self.s.dc_grid, n_bootstrap=0)
+            except ValueError as exc:  # (fewer than 3 usable points at this k0)
+                log.warning("D_c (a) at k0 = %g alone: %s", k0, exc)
+                continue
+            Dc_b = float(per_b.get(k0, math.nan))
+            rows.append({"k0": float(k0), "n_points": fit.n_points, "Dc_a": fit.Dc, "Dc_a_lo": fit.Dc_profile[0],
+                         "Dc_a_hi": fit.Dc_profile[1], "rms_a": fit.rms, "one_sided": fit.one_sided,
+                         "Dc_b": Dc_b, "ratio_a_b": fit.Dc / Dc_b if Dc_b > 0 else math.nan})
+        frame = pd.DataFrame(rows).sort_values("k0", ascending=False, ignore_index=True) if rows else pd.DataFrame()
+        self.tables["dc_per_k0"] = frame
+        return frame
+
+    @cached_property
     def dc_critical(self) -> fits.DcCriticalFit:
         """D_c (b), from micro's exact V^c at every k0 of :attr:`critical`."""
         crit = self.critical

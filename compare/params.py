@@ -80,13 +80,13 @@ class Settings:
     reference_k0, reference_V : a stiffness k0 >= k2, at which micro slides steadily at
         every V; its branch on ``reference_V`` reaches V ~ B and pins the shape of Eq. (10).
     fp_points : (k0, V / V^c) of the stick-slip points that the D_c fit matches (with
-        exact steady points at ``steady_ratios`` V^c at the same k0); ``fp_k0`` is the set
-        of their k0 (the names are older than the cohort method: the points are solved by
-        ``cycle_method``).  With ``cycle_method="fp"``, the FP's cost grows near V^c (a
+        exact steady points at ``steady_ratios`` V^c at the same k0): by default two at
+        each of the paper's five k0, so that D_c (a) is fitted at every k0 and also per k0
+        (``dc_per_k0``); ``fp_k0`` is the set of their k0 (the names are older than the
+        cohort method: the points are solved by ``cycle_method``).  With ``cycle_method="fp"``, the FP's cost grows near V^c (a
         cycle a few bins high settles slowly), at k0 = 0.3 faster than at 0.1.
     shown_points : (k0, V / V^c) of stick-slip points drawn on the diagram (by
-        ``cycle_method``) but not matched by the fit: micro's side of the diagram at the
-        small k0, where the fitted D_c is a prediction.
+        ``cycle_method``) but not matched by the fit (none by default).
     cycle_method, cycle_rtol : how the stick-slip points are solved (above).
     dc_bounds, dc_grid, bootstrap : D_c search range, scan resolution, bootstrap samples.
     hopf_k0 : k0 of the transition study; ``hopf_distances``: d = (V^c - V)/V^c of its
@@ -122,9 +122,9 @@ class Settings:
     reference_k0: float = 1.0
     reference_V: tuple[float, ...] = _geom(1e-3, 1e3, 25)
     fp_points: tuple[tuple[float, float], ...] = ((0.3, 0.15), (0.3, 0.4), (0.1, 0.15), (0.1, 0.4), (0.1, 0.55),
-                                                  (0.1, 0.7))
-    shown_points: tuple[tuple[float, float], ...] = ((0.01, 0.4), (0.01, 0.7), (0.001, 0.4), (0.001, 0.7),
-                                                     (0.0001, 0.4), (0.0001, 0.7))
+                                                  (0.1, 0.7), (0.01, 0.4), (0.01, 0.7), (0.001, 0.4), (0.001, 0.7),
+                                                  (0.0001, 0.4), (0.0001, 0.7))
+    shown_points: tuple[tuple[float, float], ...] = ()
     cycle_method: str = "cohort"
     cycle_rtol: float = 1e-3
     steady_ratios: tuple[float, ...] = (1.5, 3.0)
@@ -249,8 +249,9 @@ class Settings:
         """More points, the paper's Figs. 3 and 10, finer N-block runs (opt-in: minutes)."""
         base = cls(branch_points=80, unstable_points=32, reference_V=_geom(1e-3, 1e3, 49),
                    fp_points=tuple([(0.3, r) for r in (0.05, 0.15, 0.3, 0.4, 0.55)] +
-                                   [(0.1, r) for r in (0.05, 0.15, 0.3, 0.4, 0.55, 0.7, 0.85)]),
-                   shown_points=tuple((k0, r) for k0 in (0.01, 0.001, 0.0001) for r in (0.15, 0.4, 0.55, 0.7, 0.85)),
+                                   [(0.1, r) for r in (0.05, 0.15, 0.3, 0.4, 0.55, 0.7, 0.85)] +
+                                   [(k0, r) for k0 in (0.01, 0.001, 0.0001) for r in (0.15, 0.4, 0.55, 0.7, 0.85)]),
+                   shown_points=(),
                    steady_ratios=(1.2, 1.5, 2.0, 3.0, 5.0),
                    hopf_distances=(0.1, 0.2, 0.3, 0.45, 0.6), nblock_N=(100000, 300000),
                    nblock_distances=(0.01, 0.02, 0.03, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5),

@@ -52,6 +52,8 @@ def run(ctx: Context) -> Part:
     if s.shown_points:
         part.tables["micro_shown_points"] = ctx.points(s.shown_points, "shown")
     crit = _critical_table(ctx, part)
+    if ctx.Dc_given is None:
+        ctx.dc_per_k0
     Dc = ctx.Dc
 
     def V_range(k0: float) -> tuple[float, float]:
@@ -192,6 +194,26 @@ def _dc(ctx: Context, t, v) -> list[str]:
                          f"(per-k0 values {fmt(lo_b, 3)} to {fmt(hi_b, 3)}): one RS law with one D_c cannot "
                          f"carry both micro's cycle amplitudes and its stability boundary.")
         lines.append("")
+    per_a = t.get("dc_per_k0")
+    if per_a is not None and len(per_a) > 1:
+        lines += ["", "D_c (a) fitted at each k0 alone (its stick-slip extrema and steady points) beside D_c (b) at "
+                  "that k0:", "", "| k0 | points | D_c (a) alone | profile | rms | D_c (b) | (a)/(b) |",
+                  "|---|---|---|---|---|---|---|"]
+        for _, r in per_a.iterrows():
+            side = f" ({r.one_sided} bound)" if isinstance(r.one_sided, str) and r.one_sided else ""
+            lines.append(f"| {r.k0:g} | {int(r.n_points)} | {fmt(r.Dc_a)}{side} | [{fmt(r.Dc_a_lo, 3)}, "
+                         f"{fmt(r.Dc_a_hi, 3)}] | {fmt(r.rms_a, 3)} | {fmt(r.Dc_b)} | {fmt(r.ratio_a_b, 3)} |")
+        a_lo, a_hi = float(per_a.Dc_a.min()), float(per_a.Dc_a.max())
+        b_lo, b_hi = float(per_a.Dc_b.min()), float(per_a.Dc_b.max())
+        lines += ["", f"Across the {len(per_a)} k0 the per-k0 optimum of (a) spans {fmt(a_lo, 3)} to {fmt(a_hi, 3)} "
+                  f"(a factor {a_hi / a_lo:.2g}) and (b) spans {fmt(b_lo, 3)} to {fmt(b_hi, 3)} (a factor "
+                  f"{b_hi / b_lo:.2g}); their ratio (a)/(b) runs from {fmt(float(per_a.ratio_a_b.min()), 3)} to "
+                  f"{fmt(float(per_a.ratio_a_b.max()), 3)}. The two ask different things of the law's shape: (b) "
+                  "only its slope at micro's V^c (k0 D_c = W(V^c), one number per k0), (a) the whole weakening "
+                  "between the velocities a cycle visits (its extrema are set by how far the law falls from "
+                  "sigma_max to the slip's velocities): a ratio (a)/(b) that moves with k0 means the fitted law's "
+                  "weakening away from V^c does not scale like its slope at V^c, so no single D_c, and no "
+                  "per-k0 D_c either, lets one RS law carry both.", ""]
     lines.append("Figure `critical_velocity.png`: V^c(k0) of micro (exact) and of RS with each D_c.")
     lines.append("")
     return lines

@@ -67,6 +67,18 @@ def test_dc_from_critical_velocity_reproduces_each_k0(rep):
     assert per.set_index("k0").Dc_exact_slope[1e-4] == pytest.approx(0.1, rel=2e-3)
 
 
+def test_dc_per_k0_alone_is_the_global_fit_where_one_k0_is_fitted(rep):
+    """The quick preset fits D_c (a) at k0 = 0.1 only: the per-k0 fit there sees the same
+    points, so it must land on the same optimum, and its D_c (b) is that k0's V^c match."""
+    per = rep["dc_per_k0"]
+    assert list(per.k0) == [0.1]
+    row = per.iloc[0]
+    assert row.Dc_a == pytest.approx(rep.values["Dc"], rel=1e-9)
+    assert row.Dc_a_lo <= row.Dc_a <= row.Dc_a_hi
+    assert row.Dc_b == pytest.approx(float(rep["dc_critical"].set_index("k0").Dc_law[0.1]), rel=1e-12)
+    assert row.ratio_a_b == pytest.approx(row.Dc_a / row.Dc_b, rel=1e-12)
+
+
 def test_transition_evidence(rep):
     tr = rep.values["transition"]
     assert tr["growth_diverges"] and tr["hopf"] is False
