@@ -8,6 +8,7 @@ else in :mod:`rsf` calls :func:`integrate` and gets an :class:`OdeSolution`.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
@@ -114,7 +115,19 @@ def integrate_outputs(rhs: Callable[[float, np.ndarray, np.ndarray], None], y0: 
     step has fallen below the round-off of the independent variable (``t + h == t``, a
     solution that blows up) stops with status -3 instead of stalling.  With ``save_steps``
     every internal step is returned (``t``, ``y``), else the end points.
+
+    With ``save_steps``, events and no ``out_times`` the run is first made in one call of
+    scikit-sundae's ``solve`` (:func:`_steps_in_one_call`: the steps are saved in compiled
+    code, no Python round trip per step) and gives the same result to the last bit; only
+    where the two could differ (a stall, the step bound, a root at ``t1`` or on a step) is
+    it made again one step at a time.
     """
+    if save_steps and events is not None and n_out_times(out_times) == 0:
+        sol = _steps_in_one_call(rhs, y0, t0, t1, events=events, terminal=terminal,
+                                 direction=direction, rtol=rtol, atol=atol, method=method,
+                                 max_num_steps=max_num_steps)
+        if sol is not None:
+            return sol
     n_events = len(terminal)
     out_times = np.ascontiguousarray(out_times if out_times is not None else [], dtype=float)
     pending = [0]
@@ -189,3 +202,124 @@ def integrate_outputs(rhs: Callable[[float, np.ndarray, np.ndarray], None], y0: 
         t_arr, y_arr = np.array([t0, t_now]), np.vstack([y0, y_now])
     return OdeSolution(t=t_arr, y=y_arr, events=found, terminal_event=terminal_event,
                        status=status, message=message, success=success, nfev=nfev)
+
+
+def n_out_times(out_times) -> int:
+    """The number of output times (0 for None)."""
+    return 0 if out_times is None else int(np.size(out_times))
+
+
+#: Steps in a row whose advance is below the round-off of the independent variable after
+#: which :func:`integrate_outputs` ends a run (status -3).
+STALL_STEPS = 3
+_STALL_MESSAGE = "step size below the round-off of the independent variable"
+
+
+def _stalled(t: np.ndarray, is_root: np.ndarray) -> bool:
+    """Whether :func:`integrate_outputs`'s stall test fires on the returns ``t[1:]``
+    (``is_root``: root returns, which the test skips without resetting its count)."""
+    d = np.diff(t)
+    tiny = d <= 8.0 * np.finfo(float).eps * np.maximum(np.abs(t[1:]), 1.0)
+    flags = tiny[~is_root[1:]]
+    if flags.size < STALL_STEPS:
+        return False
+    run = flags[:flags.size - STALL_STEPS + 1].copy()
+    for k in range(1, STALL_STEPS):
+        run &= flags[k:flags.size - STALL_STEPS + 1 + k]
+    return bool(run.any())
+
+
+def _steps_in_one_call(rhs, y0, t0, t1, *, events, terminal, direction, rtol, atol, method,
+                       max_num_steps) -> OdeSolution | None:
+    """What :func:`integrate_outputs` returns with ``save_steps`` and no output times, from
+    one call of scikit-sundae's ``solve`` over ``[t0, t1]`` (CVODE's one-step mode with the
+    stop time ``t1``: the same CVODE calls, the steps saved in compiled code instead of one
+    Python round trip and result object per step).
+
+    ``solve`` keeps a root return only in its event list (the step loop also saves it as a
+    point), saves the point of a failed step (the loop does not), and has no step bound
+    and no stall test.  The points are merged back in time order, and the function returns
+    None -- the caller then steps one at a time -- wherever the results could differ: a
+    root at or beyond ``t1`` or at the time of a step, more than ``max_num_steps`` returns,
+    or :data:`STALL_STEPS` steps in a row below the round-off of the independent variable.
+    A stall would never end inside ``solve``: a hidden extra event, watched in the event
+    function, then turns terminal and ends the call.
+    """
+    n_events = len(terminal)
+    if len(direction) != n_events or n_events == 0:
+        raise ValueError("terminal and direction must list one entry per event")
+    eps8 = 8.0 * np.finfo(float).eps
+    max_steps = int(max_num_steps)
+    # the watch: the latest step end, the time beyond which a step end is a real advance,
+    # stalled steps in a row, whether the last call was at the step end, steps, hidden event
+    top, beyond, stalls, at_top, steps, flag = -math.inf, -math.inf, 0, False, 0, 1.0
+
+    def eventsfn(t, y, e):
+        nonlocal top, beyond, stalls, at_top, steps, flag
+        events(t, y, e)
+        if t > beyond:          # the end of a new step (the usual case)
+            top = t
+            beyond = t + eps8 * (t if t > 1.0 else (-t if t < -1.0 else 1.0))
+            stalls = 0
+            at_top = True
+            steps += 1
+            if steps > max_steps:
+                flag = -1.0
+        elif t > top or (t == top and at_top):   # a step that advanced below the round-off
+            top = t
+            at_top = True
+            stalls += 1
+            if stalls >= STALL_STEPS:
+                flag = -1.0
+        else:                   # the root finder looks below the step end
+            at_top = False
+        e[n_events] = flag
+
+    eventsfn.terminal = [bool(x) for x in terminal] + [True]
+    eventsfn.direction = [int(x) for x in direction] + [-1]
+    solver = sun.cvode.CVODE(rhs, rtol=rtol, atol=atol, method=method,
+                             max_num_steps=int(max_num_steps), eventsfn=eventsfn,
+                             num_events=n_events + 1)
+    y0 = np.ascontiguousarray(y0, dtype=float)
+    sol = solver.solve(np.array([t0, t1], dtype=float), y0)
+    if flag < 0.0:
+        return None
+    status = int(sol.status)
+    t = np.asarray(sol.t, dtype=float)
+    y = np.asarray(sol.y, dtype=float).reshape(t.size, y0.size)
+    n_returns = t.size - 1
+    if status < 0:                  # the step loop keeps the last successful step
+        t, y = t[:-1], y[:-1]
+    found: list[tuple[float, np.ndarray, int, int]] = []
+    terminal_event = None
+    is_root = np.zeros(t.size, dtype=bool)
+    if sol.i_events is not None:
+        i_ev = np.asarray(sol.i_events).reshape(-1, n_events + 1)[:, :n_events]
+        t_ev = np.asarray(sol.t_events, dtype=float).ravel()
+        y_ev = np.asarray(sol.y_events, dtype=float).reshape(-1, y0.size)
+        for k in range(t_ev.size):
+            for idx in np.flatnonzero(i_ev[k]):
+                found.append((float(t_ev[k]), y_ev[k].copy(), int(idx), int(np.sign(i_ev[k, idx]))))
+        inner = t_ev.size
+        if status == 2:             # stopped at a terminal root, saved as the last point
+            for idx in np.flatnonzero(i_ev[-1]):
+                if terminal[idx]:
+                    terminal_event = int(idx)
+                    break
+            inner -= 1
+            is_root[-1] = True
+        n_returns += inner
+        if inner:
+            t_in, y_in = t_ev[:inner], y_ev[:inner]
+            if np.any(t_in >= t1):
+                return None
+            pos = np.searchsorted(t, t_in, side="left")
+            if np.any(t[np.minimum(pos, t.size - 1)] == t_in):
+                return None
+            t = np.insert(t, pos, t_in)
+            y = np.insert(y, pos, y_in, axis=0)
+            is_root = np.insert(is_root, pos, True)
+    if n_returns > max_num_steps or np.any(t[:-1] >= t1) or _stalled(t, is_root):
+        return None
+    return OdeSolution(t=t, y=y, events=found, terminal_event=terminal_event, status=status,
+                       message=str(sol.message), success=bool(sol.success), nfev=int(sol.nfev))
