@@ -13,7 +13,6 @@ The obvious entry point is :func:`simulate`::
 """
 from __future__ import annotations
 
-from .analysis import CriticalVelocity, HopfFit, critical_velocity, fit_power_law, hopf_scaling
 from .laws import (
     PAPER_A,
     PAPER_B,
@@ -39,6 +38,8 @@ from .state_laws import (
 )
 from .results import STATUS_MESSAGES, CycleResult, Event, Status, SweepResult, Trajectory
 from .solver import limit_cycle, simulate, sweep
+from .stability import CriticalVelocity, critical_velocity
+from .hopf import HopfFit, fit_power_law, hopf_scaling
 
 __all__ = [
     "simulate",

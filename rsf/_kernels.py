@@ -532,7 +532,7 @@ def slide_rhs(y, yp, p, c):
 
     ``y = [z, t, I]`` with :math:`\theta = \theta_s e^{z}`, local time ``t`` and
     :math:`I = \int\sigma\,\mathrm{d}t`; ``c = [K, V, Dc, v_s, u_s, ...]`` where
-    :math:`u_s = D_c/\theta_s`.  From Eqs. (8), (11), (12):
+    :math:`u_s = D_c/\theta_s` (the fields of :class:`rsf.engines.phase.SlideConstants`).  From Eqs. (8), (11), (12):
     :math:`\mathrm{d}z/\mathrm{d}\tau = (u - V)/v_s`.
     """
     K = c[0]
@@ -548,8 +548,9 @@ def slide_rhs(y, yp, p, c):
 def slide_events(y, e, p, c):
     """Slide events: ``e[0]`` D (slide -> slip), ``e[1]`` N (v -> 0, slide -> stick),
     ``e[2]`` |ln(u/V)| - s_tol (steady), ``e[3]`` W (interior extremum of sigma),
-    ``e[4]`` t - t_stop.  ``c[5:10] = [s_tol, t_stop, ln V, steady_on, extrema_on]``
-    (``extrema_on`` only for laws whose W changes sign)."""
+    ``e[4]`` t - t_stop (the indices of :class:`rsf.engines.phase.SlideEvent`).
+    ``c[5:10] = [s_tol, t_stop, ln V, steady_on, extrema_on]`` (``extrema_on`` only for laws
+    whose W changes sign)."""
     K = c[0]
     V = c[1]
     u = c[4] * math.exp(-y[0])
@@ -624,7 +625,8 @@ def rs_rhs_dr(y, yp, p, c, dr_user):
     so that event functions near it are not differences of large numbers) and
     :math:`I = \int (\mu - \mu_{ref})\,\mathrm{d}t`;
     ``c = [K, V, Dc, a, state_law, v_s, ...events..., eta, c/b, b2, Dc/Dc2, ln(v0/v_s),
-    dV/dt, t_0]`` (indices 12 to 18; with a ramp :math:`V(t) = V + \dot V (t - t_0)`).
+    dV/dt, t_0]`` (indices 12 to 18; with a ramp :math:`V(t) = V + \dot V (t - t_0)`): the
+    fields of :class:`rsf.engines.smooth.RsConstants`, in order.
     """
     K = c[0]
     V = c[1]
@@ -678,7 +680,8 @@ def rs_events(y, e, p, c):
     """Events of the a > 0 ODE: ``e[0]`` and ``e[1]`` ln(v/V) (sigma maximum when rising,
     minimum when falling), ``e[2]`` distance to the steady state minus s_tol, ``e[3]``
     t - t_stop, ``e[4]`` ln(v/v_max) (runaway); with a ramp ``c[17] != 0`` the extrema are
-    at v = V(t) and there is no steady state.
+    at v = V(t) and there is no steady state (the indices of
+    :class:`rsf.engines.smooth.RsEvent`).
     ``c[6:12] = [ln(V/v_s), ln(v_s/V), s_tol, steady_on, t_stop, ln(v_max/v_s)]``."""
     if c[17] != 0.0:                 # a ramp: extrema of the spring force at v = V(t)
         V = c[1] + c[17] * (y[4] - c[18])

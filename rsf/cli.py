@@ -24,7 +24,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .analysis import critical_velocity
+from .stability import critical_velocity
 from .laws import (PAPER_A, PAPER_B, PAPER_DC, PAPER_K0_MAX, HyperbolicLaw, LogLaw, TabulatedLaw,
                    ViscoelasticLaw)
 from ._validation import positive

@@ -327,8 +327,8 @@ class _CountingRuns:
     def __init__(self, monkeypatch):
         self.calls = 0
         for name in ("integrate", "integrate_outputs"):
-            original = getattr(rsf.solver, name)
-            monkeypatch.setattr(rsf.solver, name, self._wrap(original))
+            original = getattr(rsf._sundials, name)
+            monkeypatch.setattr(rsf._sundials, name, self._wrap(original))
 
     def _wrap(self, original):
         def counted(*args, **kwargs):

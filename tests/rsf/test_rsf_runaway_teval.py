@@ -47,17 +47,17 @@ STEP = rsf.Protocol.velocity_steps([1.0, 10.0], [10.0])
 @pytest.fixture
 def cvode_calls(monkeypatch):
     """A spy on rsf's CVODE drivers: (driver, right-hand-side evaluations, status) per call."""
-    import rsf.solver
+    import rsf._sundials
 
     calls = []
     for name in ("integrate", "integrate_outputs"):
-        original = getattr(rsf.solver, name)
+        original = getattr(rsf._sundials, name)
 
         def spy(*args, _original=original, _name=name, **kwargs):
             sol = _original(*args, **kwargs)
             calls.append((_name, int(sol.nfev), int(sol.status)))
             return sol
-        monkeypatch.setattr(rsf.solver, name, spy)
+        monkeypatch.setattr(rsf._sundials, name, spy)
     return calls
 
 

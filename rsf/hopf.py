@@ -1,0 +1,100 @@
+r"""The stick-slip amplitude near the Hopf bifurcation: :func:`hopf_scaling` measures
+:math:`\sigma_{max} - \sigma_{min}` at :math:`V = V^c(1 - \epsilon)` with
+:func:`rsf.limit_cycle` and fits :math:`(V^c - V)^\beta` with :func:`fit_power_law`
+(``docs/reference/rsf.md`` §7)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+import pandas as pd
+from scipy.stats import linregress
+
+from .params import SolverOptions, SpringSlider
+from .solver import limit_cycle
+from .stability import critical_velocity
+
+__all__ = ["HopfFit", "hopf_scaling", "fit_power_law"]
+
+
+def fit_power_law(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
+    """Least-squares fit of ln y = ln c + beta ln x; returns (beta, stderr of beta, c,
+    stderr of ln c)."""
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if x.size < 3:
+        raise ValueError(f"need at least 3 points for a fit with an uncertainty, got {x.size}")
+    res = linregress(np.log(x), np.log(y))
+    return float(res.slope), float(res.stderr), float(math.exp(res.intercept)), float(res.intercept_stderr)
+
+
+@dataclass
+class HopfFit:
+    r"""Amplitude :math:`\sigma_{max} - \sigma_{min}` against :math:`V^c - V` near the
+    bifurcation (:func:`hopf_scaling`).
+
+    ``exponent`` and ``exponent_stderr`` come from a least-squares fit of
+    :math:`\ln(\sigma_{max}-\sigma_{min})` on :math:`\ln(V^c - V)` over the points with
+    :math:`(V^c - V)/V^c \le` ``fit_max``; ``local_exponents`` are the slopes between
+    neighbouring points (they show where the scaling holds).
+    """
+
+    k0: float
+    Vc: float
+    epsilon: np.ndarray          # (Vc - V) / Vc
+    amplitude: np.ndarray
+    sigma_min: np.ndarray
+    sigma_max: np.ndarray
+    exponent: float
+    exponent_stderr: float
+    prefactor: float
+    fit_max: float
+    local_exponents: np.ndarray
+    converged: bool
+
+    def to_frame(self) -> pd.DataFrame:
+        return pd.DataFrame({"k0": self.k0, "Vc": self.Vc, "epsilon": self.epsilon,
+                             "V": self.Vc * (1.0 - self.epsilon), "amplitude": self.amplitude,
+                             "sigma_min": self.sigma_min, "sigma_max": self.sigma_max})
+
+
+def hopf_scaling(model: SpringSlider, epsilon: Sequence[float] | None = None, *,
+                 fit_max: float = 1e-4, options: SolverOptions | None = None) -> HopfFit:
+    r"""Measure the stick-slip amplitude at :math:`V = V^c(1 - \epsilon)` and fit
+    :math:`\sigma_{max} - \sigma_{min} \propto (V^c - V)^\beta`.
+
+    Parameters
+    ----------
+    model : SpringSlider
+    epsilon : sequence of float, optional
+        Relative distances below Vc, in (0, 1); default 12 values from 1e-7 to 1e-1.
+    fit_max : float
+        Only points with epsilon <= fit_max enter the fit (default 1e-4: the scaling
+        region next to the bifurcation).
+    options : SolverOptions, optional
+        Default: cycle_rtol = 1e-11 (the amplitude at epsilon = 1e-7 is ~1e-4 of sigma).
+    """
+    cv = critical_velocity(model)
+    if not (math.isfinite(cv.Vc) and cv.Vc > 0):
+        raise ValueError(f"no finite critical velocity for k0 = {model.k0!r}, Dc = {model.Dc!r}")
+    eps = np.asarray(np.geomspace(1e-7, 1e-1, 13) if epsilon is None else epsilon, dtype=float)
+    if np.any(~np.isfinite(eps)) or np.any(eps <= 0.0) or np.any(eps >= 1.0):
+        raise ValueError("epsilon must hold values in (0, 1)")
+    options = options or SolverOptions(cycle_rtol=1e-11, rtol=1e-12, atol=1e-14)
+    amp, smin, smax, ok = [], [], [], True
+    for e in eps:
+        r = limit_cycle(model, cv.Vc * (1.0 - e), options=options)
+        ok = ok and r.converged and r.regime == "stick-slip"
+        amp.append(r.sigma_max - r.sigma_min)
+        smin.append(r.sigma_min)
+        smax.append(r.sigma_max)
+    amp = np.array(amp)
+    x = eps * cv.Vc
+    sel = eps <= fit_max
+    beta, dbeta, c, _ = fit_power_law(x[sel], amp[sel])
+    order = np.argsort(x)
+    local = np.diff(np.log(amp[order])) / np.diff(np.log(x[order]))
+    return HopfFit(model.k0, cv.Vc, eps, amp, np.array(smin), np.array(smax), beta, dbeta, c,
+                   fit_max, local, ok)
