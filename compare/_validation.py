@@ -1,5 +1,8 @@
 """Turn a bad argument into a ``ValueError`` that names the parameter and the allowed
-range.  Every public dataclass and entry point of :mod:`compare` uses these."""
+range.  Every public dataclass and entry point of :mod:`compare` uses these.
+
+The scalar checks are rsf's (:mod:`rsf._validation`, re-exported here: compare builds on
+rsf); the checks of lists are compare's own."""
 from __future__ import annotations
 
 import math
@@ -7,80 +10,10 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
+from rsf._validation import choice, in_range, nonnegative, positive, positive_int, shown
+
 __all__ = ["positive", "nonnegative", "in_range", "positive_int", "choice", "positive_array",
            "choices", "shown"]
-
-
-def shown(value: object) -> str:
-    """``repr(value)`` with numpy scalars and arrays as plain Python numbers and lists, so
-    that a message reads ``got 1.0``, never ``got np.float64(1.0)``."""
-    if isinstance(value, np.generic):
-        return repr(value.item())
-    if isinstance(value, np.ndarray):
-        return repr(value.tolist())
-    if isinstance(value, (tuple, list)) and any(isinstance(v, np.generic) for v in value):
-        return repr(type(value)(v.item() if isinstance(v, np.generic) else v for v in value))
-    return repr(value)
-
-
-def _as_float(name: str, value: object) -> float:
-    if isinstance(value, (bool, np.bool_, str, bytes)):
-        raise ValueError(f"{name} must be a real number, got {shown(value)}")
-    try:
-        return float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {shown(value)}") from None
-
-
-def positive(name: str, value: object) -> float:
-    """``value`` as a float; raise unless finite and > 0."""
-    v = _as_float(name, value)
-    if not (math.isfinite(v) and v > 0.0):
-        raise ValueError(f"{name} must be a finite number > 0, got {shown(value)}")
-    return v
-
-
-def nonnegative(name: str, value: object) -> float:
-    """``value`` as a float; raise unless finite and >= 0."""
-    v = _as_float(name, value)
-    if not (math.isfinite(v) and v >= 0.0):
-        raise ValueError(f"{name} must be a finite number >= 0, got {shown(value)}")
-    return v
-
-
-def in_range(name: str, value: object, low: float, high: float, *, low_open: bool = False,
-             high_open: bool = False) -> float:
-    """``value`` as a float; raise unless it lies in the interval."""
-    v = _as_float(name, value)
-    ok = math.isfinite(v) and (v > low if low_open else v >= low) and (v < high if high_open else v <= high)
-    if not ok:
-        left, right = "(" if low_open else "[", ")" if high_open else "]"
-        raise ValueError(f"{name} must lie in {left}{low:g}, {high:g}{right}, got {shown(value)}")
-    return v
-
-
-def positive_int(name: str, value: object, low: int = 1, high: int | None = None) -> int:
-    """``value`` as an int; raise unless it is an integer >= ``low`` (and <= ``high``)."""
-    if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be an integer >= {low}, got {shown(value)}")
-    if isinstance(value, (int, np.integer)):
-        v = int(value)
-    elif isinstance(value, float) and value.is_integer():
-        v = int(value)
-    else:
-        raise ValueError(f"{name} must be an integer >= {low}, got {shown(value)}")
-    if v < low or (high is not None and v > high):
-        bound = f">= {low}" if high is None else f"in [{low}, {high}]"
-        raise ValueError(f"{name} must be an integer {bound}, got {shown(value)}")
-    return v
-
-
-def choice(name: str, value: object, allowed: Iterable[str]) -> str:
-    """``value`` if it is one of ``allowed``; raise naming the choices otherwise."""
-    allowed = tuple(allowed)
-    if value not in allowed:
-        raise ValueError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {shown(value)}")
-    return str(value)
 
 
 def choices(name: str, values: Iterable[str], allowed: Sequence[str]) -> tuple[str, ...]:

@@ -1,9 +1,11 @@
 """Small helpers that turn a bad parameter into a ValueError naming the parameter and
 the allowed range.  Every public dataclass of :mod:`rsf` validates itself with them on
-construction."""
+construction, and :mod:`compare` uses them too (``compare/_validation.py``).  :mod:`micro`
+has its own: micro and rsf do not import each other."""
 from __future__ import annotations
 
 import math
+from typing import Iterable
 
 import numpy as np
 
@@ -18,6 +20,8 @@ def shown(value: object) -> str:
         return repr(value.item())
     if isinstance(value, np.ndarray):
         return repr(value.tolist())
+    if isinstance(value, (tuple, list)) and any(isinstance(v, np.generic) for v in value):
+        return repr(type(value)(v.item() if isinstance(v, np.generic) else v for v in value))
     return repr(value)
 
 
@@ -75,26 +79,26 @@ def in_range(name: str, value: object, low: float, high: float, *, low_open: boo
     return result
 
 
-def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
+def choice(name: str, value: object, allowed: Iterable[str]) -> str:
     """Return ``value`` if it is one of ``allowed``, or raise naming the choices."""
+    allowed = tuple(allowed)
     if value not in allowed:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {shown(value)}")
     return str(value)
 
 
-def positive_int(name: str, value: object) -> int:
-    """Return ``value`` as an int, or raise unless it is an integer >= 1."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int,)) and not (
-        isinstance(value, float) and value.is_integer()
-    ):
-        try:
-            if isinstance(value, np.integer):
-                value = int(value)
-            else:
-                raise TypeError
-        except TypeError:
-            raise ValueError(f"{name} must be an integer >= 1, got {shown(value)}") from None
-    result = int(value)  # type: ignore[arg-type]
-    if result < 1:
-        raise ValueError(f"{name} must be an integer >= 1, got {shown(value)}")
-    return result
+def positive_int(name: str, value: object, low: int = 1, high: int | None = None) -> int:
+    """Return ``value`` as an int, or raise unless it is an integer >= ``low`` (and <=
+    ``high``); an integral float passes, a bool does not."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be an integer >= {low}, got {shown(value)}")
+    if isinstance(value, (int, np.integer)):
+        v = int(value)
+    elif isinstance(value, float) and value.is_integer():
+        v = int(value)
+    else:
+        raise ValueError(f"{name} must be an integer >= {low}, got {shown(value)}")
+    if v < low or (high is not None and v > high):
+        bound = f">= {low}" if high is None else f"in [{low}, {high}]"
+        raise ValueError(f"{name} must be an integer {bound}, got {shown(value)}")
+    return v
