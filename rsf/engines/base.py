@@ -3,6 +3,7 @@ output at requested times (``t_eval``), the stop of a run with a status, and the
 right-hand-side evaluations against the step budget."""
 from __future__ import annotations
 
+import functools
 import logging
 import weakref
 from dataclasses import dataclass, field
@@ -16,7 +17,7 @@ from ..results import Event, Status
 __all__ = ["Engine", "Kernels", "Samples", "Stop", "TAU_CHUNK", "compiled", "onto_time",
            "cvode_arrays"]
 
-logger = logging.getLogger("rsf.solver")
+logger = logging.getLogger("rsf.solver")     # the name the engines' messages have always had
 
 #: Length of one CVODE run in the slide time tau of the a = 0 engine (its first run; see
 #: :func:`rsf.engines.phase.chunk_span`) and in the natural time s of the a > 0 engine.
@@ -133,6 +134,12 @@ class Engine:
         self.samples = Samples()
         self.events: list[Event] = []
         self.nfev = 0              # right-hand-side evaluations so far, against the budget
+
+    @functools.cached_property
+    def law_compiled(self):
+        """The law's kernel (v, p) -> (mu_ss - mu_ref, W), compiled for a float and ``p``
+        (:func:`compiled`): the samples evaluate it once each."""
+        return compiled(self.k.law_eval, 1.0, self.p)
 
     # -- the step budget -------------------------------------------------------------------
     def charge(self, nfev: int) -> None:

@@ -405,7 +405,7 @@ class PhaseEngine(Engine):
                       V: float, out_times: np.ndarray | None) -> None:
         """The samples of a slide: every internal step, or the t_eval times (the output
         events, moved exactly onto the requested times)."""
-        law, p = self.law_fn, self.p
+        law, p = self.law_compiled, self.p
         if self.t_eval is None:
             ys = sol.y[1:]
         else:
@@ -418,8 +418,9 @@ class PhaseEngine(Engine):
             self.next_out += ys.shape[0]
         theta_arr = theta_s * np.exp(ys[:, 0])
         u_arr = self.Dc / theta_arr
-        mu_arr = np.array([law(u, p)[0] for u in u_arr])
-        w_arr = np.array([law(u, p)[1] for u in u_arr])
+        mu_w = [law(u, p) for u in u_arr]
+        mu_arr = np.array([mu for mu, _ in mu_w])
+        w_arr = np.array([w for _, w in mu_w])
         d_arr = self.K - w_arr
         with np.errstate(divide="ignore", invalid="ignore"):
             v_arr = (self.K * V - u_arr * w_arr) / d_arr

@@ -278,7 +278,8 @@ class SmoothEngine(Engine):
     def _record(self, y: np.ndarray) -> None:
         m = self.model
         u = np.exp(-y[:, 1])
-        mu = np.array([self.law_fn(ui, self.p)[0] for ui in u])
+        law, p = self.law_compiled, self.p
+        mu = np.array([law(ui, p)[0] for ui in u])
         with np.errstate(over="ignore"):
             v = np.exp(y[:, 0])
         sigma = self.mu_ref + mu + m.a * (y[:, 0] + y[:, 1])
