@@ -38,6 +38,8 @@ from .state_laws import (
 )
 from .results import STATUS_MESSAGES, CycleResult, Event, Status, SweepResult, Trajectory
 from .solver import limit_cycle, simulate, sweep
+from .normal_form import (HopfNormalForm, StickSlipNormalForm, classify_spectrum, cycle_near_hopf,
+                          hopf_normal_form, stick_slip_normal_form, transition_spectrum)
 from .stability import CriticalVelocity, critical_velocity
 from .hopf import HopfFit, fit_power_law, hopf_scaling
 
@@ -48,6 +50,11 @@ __all__ = [
     "critical_velocity",
     "hopf_scaling",
     "fit_power_law",
+    "hopf_normal_form",
+    "stick_slip_normal_form",
+    "transition_spectrum",
+    "classify_spectrum",
+    "cycle_near_hopf",
     "reference_cycle",
     "SpringSlider",
     "standard_rs",
@@ -76,6 +83,8 @@ __all__ = [
     "SweepResult",
     "CriticalVelocity",
     "HopfFit",
+    "HopfNormalForm",
+    "StickSlipNormalForm",
     "Event",
     "Status",
     "STATUS_MESSAGES",
