@@ -2,6 +2,7 @@
 
 Parts (one CSV, benchmarks/results/rsf_normal_form.csv, column ``part``):
 
+* ``verdict``: rsf.hopf_normal_form for the laws and state laws of rsf (kind, l1, c).
 * ``hopf`` (a > 0): the simulated amplitude sigma_max - sigma_min over c d^(1/2), c from
   the first Lyapunov coefficient (rsf.hopf_normal_form), at d = 1e-3 ... 1e-7, for Eq. (10)
   with a = 1e-3 (aging and slip law, k0 = 0.1) and for the classical log law with radiation
@@ -22,7 +23,7 @@ Parts (one CSV, benchmarks/results/rsf_normal_form.csv, column ``part``):
 
     python benchmarks/rsf_normal_form.py [--quick]
 
-(about 3 minutes on this 2-core machine; --quick: fewer points, about 1 minute).
+(about 70 s on this 2-core machine under load; --quick: fewer points, about 40 s).
 """
 from __future__ import annotations
 
@@ -44,6 +45,42 @@ OUT = Path(__file__).resolve().parent / "results" / "rsf_normal_form.csv"
 TIGHT = rsf.SolverOptions(cycle_rtol=1e-11, rtol=1e-14, atol=1e-16)
 A0_OPTIONS = rsf.SolverOptions(cycle_rtol=1e-12, rtol=1e-12, atol=1e-14)
 B_LOG, DC_LOG, A_LOG = 0.01, 10.0, 0.005
+
+
+def verdict_cases() -> list[tuple[str, rsf.SpringSlider, dict]]:
+    kc = (B_LOG - A_LOG) / DC_LOG
+    log = dict(mu0=0.6, a=A_LOG, b=B_LOG, Dc=DC_LOG, k0=0.8 * kc, v0=1.0)
+    cases = [(f"Eq. 10, k0 = 0.1, {sl}, a = {a:g}", rsf.SpringSlider(k0=0.1, a=a, state_law=sl), {})
+             for sl in ("aging", "slip", "prz") for a in (1e-2, 1e-3, 1e-5)]
+    cases += [(f"Eq. 4, k0 = 0.01, {sl}, a = 1e-3",
+               rsf.SpringSlider(law=rsf.ViscoelasticLaw(), k0=0.01, a=1e-3, state_law=sl), {})
+              for sl in ("aging", "slip", "prz")]
+    cases += [("Eq. 10, k0 = 0.1, Nagata c = 0.5 (b = 0.01), a = 1e-3",
+               rsf.SpringSlider(k0=0.1, a=1e-3, state_law=rsf.NagataLaw(c=0.5, b=0.01)), {}),
+              ("Eq. 10, k0 = 0.1, aging, a = 1e-3, eta = 1e-3", rsf.SpringSlider(k0=0.1, a=1e-3, eta_rad=1e-3), {})]
+    cases += [(f"log law, {sl}, no damping (k0 varies, V = 1)", rsf.standard_rs(**log, state_law=sl),
+               dict(parameter="k0", V=1.0)) for sl in ("aging", "slip", "prz")]
+    cases += [(f"log law, {sl}, eta = 1e-3", rsf.standard_rs(**log, eta_rad=1e-3, state_law=sl), {})
+              for sl in ("aging", "slip", "prz")]
+    cases += [("log law, aging, eta = 1e-4, second state b2 = 0.004, Dc2 = 50, k0 = 4e-4",
+               rsf.standard_rs(mu0=0.6, a=A_LOG, b=B_LOG, Dc=DC_LOG, k0=4e-4, v0=1.0, eta_rad=1e-4,
+                               second_state=rsf.SecondState(0.004, 50.0)), {})]
+    return cases
+
+
+def part_verdicts() -> list[dict]:
+    rows = []
+    print("Hopf normal forms (rsf.hopf_normal_form): critical V (or k0), omega, l1, kind, c")
+    for name, model, kw in verdict_cases():
+        h = rsf.hopf_normal_form(model, **kw)
+        crit = h.Vc if h.parameter == "V" else h.k0c
+        print(f"  {name:<72} {h.parameter}c = {crit:<9.6g} omega = {h.omega:<8.4g} l1 = {h.l1:<11.4e} "
+              f"{h.kind:<13} c = {h.prefactor:<9.5g} ({h.method})")
+        rows.append({"part": "verdict", "case": name, "law": h.law, "state_law": h.state_law, "k0": model.k0,
+                     "a": model.a, "eta_rad": model.eta_rad, "Vc": h.Vc, "k0c": h.k0c, "omega": h.omega,
+                     "l1": h.l1, "l1_error": h.l1_error, "kind": h.kind, "prefactor": h.prefactor,
+                     "method": h.method})
+    return rows
 
 
 def hopf_cases() -> dict[str, rsf.SpringSlider]:
@@ -179,10 +216,10 @@ def part_spectrum(a_values, ds) -> list[dict]:
                          "growth_rate": row.growth_rate, "frequency": row.frequency,
                          "other_rate": row.other_rate, "fast_rate": row.fast_rate,
                          "growth_rate_tau": row.growth_rate_tau, "frequency_tau": row.frequency_tau})
+        print(f"a = {a:g}: growth rate / |Im| of the unstable mode (1/time): "
+              + ", ".join(f"d = {r.d:.0e}: {r.growth_rate:.4g} / {r.frequency:.4g}" for r in sp.itertuples()))
         near = sp.iloc[int(np.argmin(sp.d))]
-        print(f"a = {a:g}: growth rate {sp.growth_rate.iloc[-1]:.4g} (d = {sp.d.iloc[-1]:g}) ... "
-              f"{near.growth_rate:.4g} (d = {near.d:g}), frequency at the smallest d {near.frequency:.4g} "
-              f"(tau units: {near.frequency_tau:.4g})")
+        print(f"   in units of V/Dc at d = {near.d:g}: Re {near.growth_rate_tau:.4g}, Im {near.frequency_tau:.4g}")
         for label, dd in ranges.items():
             per = periods(model, dd)
             verdict = rsf.classify_spectrum(sp, per)
@@ -218,10 +255,11 @@ def main() -> None:
         hopf_ds, a0_k0, a0_ds = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7], [0.3, 0.1, 0.01, 0.001], \
             [1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
         cross_a, cross_ds = [1e-4, 1e-5], [0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 1e-4, 1e-5, 1e-6]
-    rows = part_hopf(hopf_ds)
+    rows = part_verdicts()
+    rows += part_hopf(hopf_ds)
     rows += part_stick_slip(a0_k0, a0_ds)
     rows += part_crossover(cross_a, cross_ds)
-    rows += part_spectrum([1e-2, 1e-3, 1e-4, 1e-5, 0.0], np.geomspace(1e-6, 0.5, 15))
+    rows += part_spectrum([1e-2, 1e-3, 1e-4, 1e-5, 0.0], [1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 0.1, 0.5])
     OUT.parent.mkdir(exist_ok=True)
     pd.DataFrame(rows).to_csv(OUT, index=False)
     print(f"\nwrote {OUT} ({len(rows)} rows) in {time.perf_counter() - t0:.0f} s")
