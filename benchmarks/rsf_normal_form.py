@@ -9,6 +9,8 @@ Parts (one CSV, benchmarks/results/rsf_normal_form.csv, column ``part``):
   damping (aging and slip; a = 0.005, b = 0.01, Dc = 10, k0 = 0.8 k_c, eta = 1e-3).  The
   cycles come from rsf.cycle_near_hopf (the section map's fixed point by the secant method
   on rsf.simulate, confirmed by rsf.limit_cycle), CVODE rtol 1e-14.
+* ``above``: the damped slip law at 1.001 and 1.01 V^c from small and large perturbations
+  (a subcritical bifurcation would let some of them reach a cycle).
 * ``stick-slip`` (a = 0, Eq. 10, k0 = 0.3 ... 1e-3): rsf.limit_cycle's amplitude against the
   exact two-equation reduction of the return map and against c0 d^(1/2) (1 + c2 d)
   (rsf.stick_slip_normal_form), d = 1e-1 ... 1e-8.
@@ -125,6 +127,27 @@ def part_hopf(ds) -> list[dict]:
                          "l1": nf.l1, "kind": nf.kind, "prefactor": nf.prefactor, "omega": nf.omega,
                          "d": d, "V": r.V, "amplitude": amp, "ratio": ratio, "period": r.period,
                          "converged": r.converged, "n_cycles": r.n_cycles, "seconds": t})
+    return rows
+
+
+def part_above(factors, perturbations) -> list[dict]:
+    """The damped slip law just above V^c: does any start reach a cycle (subcritical)?"""
+    rows = []
+    model = hopf_cases()["log law, slip, eta = 1e-3"]
+    Vc = rsf.critical_velocity(model).Vc
+    print("\nlog law, slip, eta = 1e-3, above V^c: rsf.limit_cycle from theta perturbed (max 3000 cycles)")
+    for f in factors:
+        for pert in perturbations:
+            r = rsf.limit_cycle(model, f * Vc, initial=rsf.InitialState(perturbation=pert),
+                                options=rsf.SolverOptions(max_cycles=3000))
+            amp = r.sigma_max - r.sigma_min
+            print(f"  V = {f:g} Vc, perturbation {pert:g}: {r.regime} ({r.n_cycles} cycles; amplitude "
+                  f"{amp:.3g}, last relative change {r.relative_change:.2g})")
+            rows.append({"part": "above", "case": "log law, slip, eta = 1e-3", "law": "log", "state_law": "slip",
+                         "k0": model.k0, "a": model.a, "eta_rad": model.eta_rad, "Vc": Vc, "d": 1.0 - f,
+                         "V": f * Vc, "perturbation": pert, "regime": r.regime, "amplitude": amp,
+                         "relative_change": r.relative_change, "n_cycles": r.n_cycles,
+                         "converged": r.converged})
     return rows
 
 
@@ -257,6 +280,7 @@ def main() -> None:
         cross_a, cross_ds = [1e-4, 1e-5], [0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 1e-4, 1e-5, 1e-6]
     rows = part_verdicts()
     rows += part_hopf(hopf_ds)
+    rows += part_above([1.001, 1.01], [1e-3, 0.3, 3.0, 30.0] if not args.quick else [0.3])
     rows += part_stick_slip(a0_k0, a0_ds)
     rows += part_crossover(cross_a, cross_ds)
     rows += part_spectrum([1e-2, 1e-3, 1e-4, 1e-5, 0.0], [1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 0.1, 0.5])

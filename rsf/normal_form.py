@@ -33,8 +33,10 @@ import pandas as pd
 from scipy.optimize import brentq
 
 from ._validation import positive
+from .analysis import critical_velocity, stability_margin, steady_jacobian
 from .laws import HyperbolicLaw, LogLaw
 from .params import InitialState, SolverOptions, SpringSlider
+from .solver import limit_cycle, simulate
 from .state_laws import AGING, NAGATA, PRZ, SLIP, USER
 
 __all__ = ["HopfNormalForm", "hopf_normal_form", "StickSlipNormalForm", "stick_slip_normal_form",
@@ -367,8 +369,6 @@ def _closed_form_l1(K: float, a: float, om1: float, om2: float, code: int) -> tu
 
 def _critical_k0(model: SpringSlider, V: float) -> float:
     """The largest k0 at which steady sliding at V is unstable (a root of the margin)."""
-    from .analysis import stability_margin
-
     def margin(lk: float) -> float:
         return stability_margin(replace(model, k0=math.exp(lk)), V)
 
@@ -382,8 +382,6 @@ def _critical_k0(model: SpringSlider, V: float) -> float:
 
 
 def _leading_growth(model: SpringSlider, V: float) -> float:
-    from .analysis import steady_jacobian
-
     lam = np.linalg.eigvals(steady_jacobian(model, V)) * V / model.Dc
     return float(np.max(lam.real))
 
@@ -412,8 +410,6 @@ def hopf_normal_form(model: SpringSlider, *, parameter: str = "V", V: float | No
     -------
     HopfNormalForm
     """
-    from .analysis import critical_velocity, steady_jacobian
-
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     if model.a == 0.0:
@@ -648,8 +644,6 @@ def stick_slip_normal_form(model: SpringSlider) -> StickSlipNormalForm:
     :math:`\sigma_{max} - \sigma_{min} = c_0 d^{1/2}(1 + c_2 d)`, and the exact cycle
     (:meth:`StickSlipNormalForm.cycle`).  (For a > 0 the same formulas give the
     :math:`a \to 0` limit taken before :math:`d \to 0`.)"""
-    from .analysis import critical_velocity
-
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     Vc = critical_velocity(model.law, k0=model.k0, Dc=model.Dc).Vc
@@ -684,8 +678,6 @@ def transition_spectrum(model: SpringSlider, d: Sequence[float]) -> pd.DataFrame
     ``growth_rate`` (it diverges as :math:`1/d`).  Columns: d, V, growth_rate, frequency,
     other_rate, fast_rate, and the same rates in units of :math:`V/D_c` (suffix ``_tau``).
     """
-    from .analysis import critical_velocity, steady_jacobian
-
     d = np.atleast_1d(np.asarray(d, dtype=float))
     cv = critical_velocity(model) if model.a > 0.0 else critical_velocity(model.law, k0=model.k0, Dc=model.Dc)
     Vc = cv.Vc
@@ -770,8 +762,6 @@ def cycle_near_hopf(model: SpringSlider, V: float, *, guess: float | None = None
 
     ``guess``: a first y at the section (default: from :func:`hopf_normal_form`).
     """
-    from .solver import limit_cycle, simulate
-
     if model.a == 0.0 or model.second_state is not None:
         raise ValueError("cycle_near_hopf needs a > 0 and one state variable")
     V = positive("V", V)
@@ -781,19 +771,15 @@ def cycle_near_hopf(model: SpringSlider, V: float, *, guess: float | None = None
         nf = hopf_normal_form(model)
         d = (nf.Vc - V) / nf.Vc
         r = nf.radius_prefactor * math.sqrt(abs(d))
-        F, L = _vector_field(model, V)
-        from .analysis import steady_jacobian
-
-        omega, q, _ = _critical_pair(steady_jacobian(model, nf.Vc))
+        _, L = _vector_field(model, V)
+        _, q, _ = _critical_pair(steady_jacobian(model, nf.Vc))
         # on the cycle x = 2 Re(z q); at the sigma minimum the spring rate w vanishes:
         # choose the phase where Re(z q_w) = 0 and sigma is lowest
         phase = math.atan2(q[0].real, q[0].imag) if q[0] != 0 else 0.0
         cands = [2.0 * (r * np.exp(1j * (phase + s)) * q).real for s in (0.0, math.pi)]
         x = min(cands, key=lambda c: float(L @ c))
         guess = float(x[1])
-    from .analysis import steady_jacobian as _sj
-
-    lam = np.linalg.eigvals(_sj(model, V))
+    lam = np.linalg.eigvals(steady_jacobian(model, V))
     period_guess = 2.0 * math.pi / max(float(np.max(np.abs(lam.imag))), 1e-3) * Dc / V
 
     def section_map(y: float) -> tuple[float, float]:
