@@ -122,6 +122,17 @@ def run(ctx: Context) -> Part:
         d=1.0 - spec.V / vc)
     part.values["transition"] = fits.classify_transition(part.tables["micro_spectrum"], part.tables["hopf_fit"],
                                                          points)
+    # RS by the same test (the growth rate of the unstable mode against d), and its
+    # amplitude law from the stick-slip map (rsf.normal_form: sigma_max - sigma_min =
+    # c0 d^(1/2) (1 + c2 d), derived, not fitted)
+    try:
+        rs_spec = rsf.transition_spectrum(model, [1e-6, 1e-4, 1e-2, 0.5])
+        part.tables["rs_spectrum"] = rs_spec
+        part.values["rs_transition"] = rsf.classify_spectrum(rs_spec)
+        nf = rsf.stick_slip_normal_form(model)
+        part.values["rs_amplitude_law"] = {"c0": float(nf.prefactor), "c2": float(nf.correction)}
+    except ValueError as exc:  # (no finite RS V^c at this k0 and D_c)
+        log.warning("RS transition at k0 = %g: %s", k0, exc)
     return part
 
 
@@ -153,4 +164,20 @@ def summary(ctx: Context, part: Part) -> list[str]:
               f"cell) and its fixed-point error; closer to V^c than d = {NEAR_VC:g} the discretisation error is "
               "not known (the cell refinement is not yet shown to converge there), and such points carry no bar. "
               "The N-block sizes differ by their finite-N error.", ""]
+    rs_tr = v.get("rs_transition")
+    if rs_tr:
+        law = v.get("rs_amplitude_law", {})
+        verdict = "diverges" if rs_tr["growth_diverges"] else "vanishes"
+        lines += [f"**Both models by one test.** The growth rate of RS's unstable mode (a = 0, the paper's Eqs. "
+                  f"11-12) {verdict} as V -> V^c: {fmt(rs_tr['growth_far'], 3)} at d = {rs_tr['d_far']:.2g}, "
+                  f"{fmt(rs_tr['growth_near'], 3)} at d = {rs_tr['d_near']:.2g} (table `rs_spectrum`). "
+                  + ("Like micro's, RS's steady sliding at a = 0 loses stability by an eigenvalue entering from "
+                     "infinity (its partner is the instantaneous slip), not by a Hopf bifurcation; only a direct "
+                     "effect a > 0 makes it one (`rsf.hopf_normal_form`: supercritical for the paper's law with the "
+                     "aging and slip laws, docs/reference/rsf.md §19). " if rs_tr["growth_diverges"] else "")
+                  + "The two models differ in the nonlinear mechanism that sets the amplitude: in RS at a = 0 the "
+                  "cycle is a stick and an instantaneous slip whose return map gives sigma_max − sigma_min = "
+                  f"c0 d^(1/2) (1 + c2 d) with c0 = {fmt(law.get('c0', math.nan), 4)} and c2 = "
+                  f"{fmt(law.get('c2', math.nan), 3)} here (derived, `rsf.stick_slip_normal_form`); in micro it is "
+                  "set by the size of its shocks. An exponent of 1/2 is no evidence of a Hopf bifurcation.", ""]
     return lines

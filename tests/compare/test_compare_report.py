@@ -79,6 +79,21 @@ def test_dc_per_k0_alone_is_the_global_fit_where_one_k0_is_fitted(rep):
     assert row.ratio_a_b == pytest.approx(row.Dc_a / row.Dc_b, rel=1e-12)
 
 
+def test_rs_transition_by_micros_test(rep):
+    """RS at a = 0, by the test that classifies micro's transition: the unstable mode's
+    growth rate diverges like 1/d (an eigenvalue entering from infinity, not a Hopf
+    pair), and the summary says so beside the derived amplitude law."""
+    tr = rep.values["rs_transition"]
+    assert tr["growth_diverges"] and tr["hopf"] is False
+    g = rep["rs_spectrum"].set_index("d").growth_rate
+    assert g[1e-6] / g[1e-4] == pytest.approx(100.0, rel=1e-2)
+    law = rep.values["rs_amplitude_law"]
+    model = rsf.SpringSlider(law=rsf.HyperbolicLaw(A=rep.values["A"], B=rep.values["B"], mu_inf=0.0), k0=0.1,
+                             Dc=rep.values["Dc"])
+    assert law["c0"] == pytest.approx(rsf.stick_slip_normal_form(model).prefactor, rel=1e-6)
+    assert "Both models by one test" in rep.summary and "no evidence of a Hopf bifurcation" in rep.summary
+
+
 def test_transition_evidence(rep):
     tr = rep.values["transition"]
     assert tr["growth_diverges"] and tr["hopf"] is False
