@@ -7,30 +7,34 @@ Two workloads, each in its own process, ``k`` = 1, 2, 3 of them started together
 * ``renewal``: ``micro.steady_sliding(micro.Model(k0=0.1), np.logspace(-1, 3, 100))``, the
   steady branch with growth rates (thousands of small BLAS solves, row 6).
 
-Compilation is apart: one process first runs each workload once (it fills numba's disk
-cache; its time is the ``compile`` row).  Then each copy imports micro, says it is ready,
-and waits; when all ``k`` are ready they are released at once and each times the call
-alone (wall and CPU seconds: loading the kernels from the disk cache, a fraction of a
-second, is in it, as in any run).  The machine's load is written beside each batch: the
-1-minute load average when the batch starts and ends, and how many threads of other
-processes were running or waiting for a processor as it started (``others_runnable``).
-Batches go ``k`` = 1, 2, 3, 1, 2, 3, ... so that a drift of the background load spreads
-over all ``k``.
+Compilation is apart: for each variant one process first runs each workload once (it
+fills numba's disk cache; its time is the ``compile`` row).  Then each copy imports
+micro, says it is ready, and waits; when all ``k`` are ready they are released at once
+and each times the call alone (wall and CPU seconds; loading the kernels from the disk
+cache, a fraction of a second, is in it, as in any run).  The machine's load is written
+beside each batch: the 1-minute load average when the batch starts and ends, and how
+many threads of other processes were running or waiting for a processor as it started
+(``others_runnable``).
 
-    python benchmarks/micro_threads_contention.py --label after            # about 2 minutes alone
-    python benchmarks/micro_threads_contention.py --label before --append  # with an older micro first on PYTHONPATH
+Variants (``--variant LABEL [VAR=VALUE ...]``, repeatable) are environments for the
+copies: another checkout first on ``PYTHONPATH``, or numba's and OpenMP's variables.
+Their batches are interleaved (repeat by repeat, k by k, variant by variant) so that a
+drift of the background load falls on all of them alike.  Without ``--variant``: this
+environment alone, labelled ``current``.
 
-The copies import whichever ``micro`` their environment finds, so a ``before`` run is
-this script with an older checkout first on ``PYTHONPATH``.  Rows go to
-``benchmarks/results/micro_threads_contention.csv`` (``--append`` keeps the rows of
-other labels).
+    python benchmarks/micro_threads_contention.py                    # about 2 minutes alone
+    python benchmarks/micro_threads_contention.py --workloads cohort \
+        --variant after PYTHONPATH=/path/to/new --variant before PYTHONPATH=/path/to/old \
+        --variant "before, 1 thread" PYTHONPATH=/path/to/old NUMBA_NUM_THREADS=1
+
+Rows go to ``benchmarks/results/micro_threads_contention.csv`` (``--append`` keeps the
+rows of other (variant, workload) pairs); the env column leaves ``PYTHONPATH`` out.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 import time
@@ -59,8 +63,7 @@ c0, w0 = time.process_time(), time.perf_counter()
 CALL
 w1, c1 = time.perf_counter(), time.process_time()
 print(json.dumps({"wall_s": w1 - w0, "cpu_s": c1 - c0, "import_s": t1 - t0,
-                  "micro": os.path.dirname(micro.__file__), "numba_threads_after": numba.get_num_threads()}),
-      flush=True)
+                  "numba_threads_after": numba.get_num_threads()}), flush=True)
 """
 
 
@@ -75,11 +78,11 @@ def _load() -> tuple[float, int]:
         return os.getloadavg()[0], -1
 
 
-def batch(workload: str, k: int, timeout: float) -> list[dict]:
+def batch(workload: str, k: int, env: dict[str, str], timeout: float) -> list[dict]:
     """``k`` copies of ``workload`` released together; a dict per copy."""
     code = CHILD.replace("CALL", WORKLOADS[workload])
     procs = [subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                              text=True) for _ in range(k)]
+                              text=True, env=env) for _ in range(k)]
     try:
         for p in procs:
             line = p.stdout.readline()
@@ -94,9 +97,9 @@ def batch(workload: str, k: int, timeout: float) -> list[dict]:
         for i, p in enumerate(procs):
             out, _ = p.communicate(timeout=max(1.0, deadline - time.monotonic()))
             rec = json.loads(out.strip().splitlines()[-1])
-            rows.append({"workload": workload, "k": k, "copy": i + 1, "phase": "run", "wall_s": rec["wall_s"],
+            rows.append({"workload": workload, "phase": "run", "k": k, "copy": i + 1, "wall_s": rec["wall_s"],
                          "cpu_s": rec["cpu_s"], "numba_threads_after": rec["numba_threads_after"],
-                         "load1_start": load1, "others_runnable": runnable, "micro": rec["micro"]})
+                         "load1_start": load1, "others_runnable": runnable})
         load1_end, _ = _load()
         for r in rows:
             r["load1_end"] = load1_end
@@ -108,63 +111,88 @@ def batch(workload: str, k: int, timeout: float) -> list[dict]:
                 p.wait()
 
 
-def compile_once(workload: str) -> dict:
+def compile_once(workload: str, env: dict[str, str]) -> dict:
     """One process runs ``workload`` once: numba compiles what its disk cache lacks."""
     load1, runnable = _load()
     start = time.perf_counter()
-    subprocess.run([sys.executable, "-c", f"import numpy as np, micro; {WORKLOADS[workload]}"], check=True)
-    return {"workload": workload, "k": 1, "copy": 1, "phase": "compile", "wall_s": time.perf_counter() - start,
+    subprocess.run([sys.executable, "-c", f"import numpy as np, micro; {WORKLOADS[workload]}"], check=True, env=env)
+    return {"workload": workload, "phase": "compile", "k": 1, "copy": 1, "wall_s": time.perf_counter() - start,
             "load1_start": load1, "others_runnable": runnable, "load1_end": _load()[0]}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--label", required=True, help="what is measured, e.g. 'before' or 'after'")
+    ap.add_argument("--variant", nargs="+", action="append", metavar=("LABEL", "VAR=VALUE"),
+                    help="a label and the environment variables of its copies (repeatable)")
     ap.add_argument("--k", default="1,2,3", help="numbers of copies at once (default 1,2,3)")
-    ap.add_argument("--repeats", type=int, default=3, help="batches of each k (default 3)")
+    ap.add_argument("--repeats", type=int, default=3, help="batches of each k and variant (default 3)")
     ap.add_argument("--workloads", default="cohort,renewal", help="of: " + ", ".join(WORKLOADS))
     ap.add_argument("--timeout", type=float, default=900.0, help="seconds for one batch (default 900)")
     ap.add_argument("--out", type=Path, default=OUT)
-    ap.add_argument("--append", action="store_true", help="keep the rows of other labels in --out")
+    ap.add_argument("--append", action="store_true", help="keep the rows of other variants and workloads in --out")
     args = ap.parse_args()
     ks = [int(x) for x in args.k.split(",")]
     workloads = args.workloads.split(",")
     for w in workloads:
         if w not in WORKLOADS:
             ap.error(f"--workloads: unknown {w!r} (known: {', '.join(WORKLOADS)})")
+    variants: list[tuple[str, dict[str, str], str]] = []
+    for label, *assignments in args.variant or [["current"]]:
+        env, shown = dict(os.environ), []
+        for a in assignments:
+            var, eq, value = a.partition("=")
+            if not eq or not var:
+                ap.error(f"--variant {label}: expected VAR=VALUE, got {a!r}")
+            env[var] = value
+            if var != "PYTHONPATH":
+                shown.append(a)
+        variants.append((label, env, " ".join(shown)))
     rows: list[dict] = []
+
+    def add(new: list[dict], label: str, shown: str, rep: int | None) -> None:
+        for r in new:
+            r.update(label=label, env=shown, repeat=rep)
+        rows.extend(new)
+
     for w in workloads:
-        rows.append(compile_once(w))
-        print(f"{w}: compile and first run {rows[-1]['wall_s']:.1f} s", flush=True)
+        for label, env, shown in variants:
+            add([compile_once(w, env)], label, shown, None)
+            print(f"{w} [{label}]: compile and first run {rows[-1]['wall_s']:.1f} s", flush=True)
         for rep in range(1, args.repeats + 1):
             for k in ks:
-                got = batch(w, k, args.timeout)
-                for r in got:
-                    r["repeat"] = rep
-                rows += got
-                print(f"{w} k={k} repeat {rep}: " + ", ".join(f"{r['wall_s']:.2f}" for r in got)
-                      + f" s (load {got[0]['load1_start']:.2f}, {got[0]['others_runnable']} other threads runnable)",
-                      flush=True)
-    frame = pd.DataFrame(rows).reindex(columns=["workload", "phase", "k", "repeat", "copy", "wall_s", "cpu_s",
-                                                "load1_start", "load1_end", "others_runnable",
-                                                "numba_threads_after", "micro"])
-    frame.insert(0, "label", args.label)
+                turn = rep + k  # the variants' order turns from batch to batch
+                for label, env, shown in variants[turn % len(variants):] + variants[:turn % len(variants)]:
+                    got = batch(w, k, env, args.timeout)
+                    add(got, label, shown, rep)
+                    print(f"{w} [{label}] k={k} repeat {rep}: " + ", ".join(f"{r['wall_s']:.2f}" for r in got)
+                          + f" s (load {got[0]['load1_start']:.2f}, {got[0]['others_runnable']} other threads "
+                          "runnable)", flush=True)
+    frame = pd.DataFrame(rows).reindex(columns=["label", "workload", "phase", "k", "repeat", "copy", "wall_s",
+                                                "cpu_s", "load1_start", "load1_end", "others_runnable",
+                                                "numba_threads_after", "env"])
     frame.insert(1, "date", time.strftime("%Y-%m-%d %H:%M"))
+    for col in ("repeat", "numba_threads_after"):
+        frame[col] = frame[col].astype("Int64")
     if args.append and args.out.exists():
         old = pd.read_csv(args.out)
-        frame = pd.concat([old[old["label"] != args.label], frame], ignore_index=True)
+        done = set(zip(frame["label"], frame["workload"]))
+        old = old[[pair not in done for pair in zip(old["label"], old["workload"])]]
+        frame = pd.concat([old, frame], ignore_index=True)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     frame.to_csv(args.out, index=False)
-    # the verdict: the median wall time of a copy at k at once, against k times one alone
-    runs = frame[(frame["label"] == args.label) & (frame["phase"] == "run")]
+    # the verdict: a copy's median wall time at k at once, against k times one alone
+    runs = frame[frame["phase"] == "run"]
     for w in workloads:
-        sub = runs[runs["workload"] == w]
-        one = statistics.median(sub[sub["k"] == 1]["wall_s"]) if (sub["k"] == 1).any() else float("nan")
-        for k in ks:
-            wall = sub[sub["k"] == k]["wall_s"]
-            med = statistics.median(wall)
-            print(f"{args.label} {w}: k={k} median {med:.2f} s per copy (min {wall.min():.2f}, max {wall.max():.2f}),"
-                  f" {med / one:.2f} x one alone (target <= {k})")
+        for label, _, _ in variants:
+            sub = runs[(runs["workload"] == w) & (runs["label"] == label)]
+            one = sub[sub["k"] == 1]["wall_s"].median() if (sub["k"] == 1).any() else float("nan")
+            for k in ks:
+                part = sub[sub["k"] == k]
+                print(f"{w} [{label}] k={k}: median {part['wall_s'].median():.2f} s per copy "
+                      f"(min {part['wall_s'].min():.2f}, max {part['wall_s'].max():.2f}; CPU "
+                      f"{part['cpu_s'].median():.2f} s), {part['wall_s'].median() / one:.2f} x one alone "
+                      f"(target <= {k}); background: load {part['load1_start'].median():.1f}, "
+                      f"{part['others_runnable'].median():.0f} other threads runnable")
     print(f"wrote {args.out}")
 
 

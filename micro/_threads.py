@@ -5,8 +5,9 @@ under load than alone (issue 39, rows 6 and 13):
 
 * **BLAS.**  The renewal chain solves systems of 32 to 384 unknowns, thousands of times
   in a growth-rate root.  Multithreaded OpenBLAS gains nothing at that size, and its
-  threads busy-wait between calls: with two other busy processes on 2 cores one
-  ``steady_sliding`` call took 100 times as long.  :func:`single_blas_thread` (a context
+  threads busy-wait between calls: beside other busy processes on 2 cores one
+  ``steady_sliding`` call used 7 times the CPU it needs, three at once 26 times
+  (docs/validation/micro_results.md, "Threads on shared cores").  :func:`single_blas_thread` (a context
   manager, also :func:`blas_single_threaded` as a decorator) holds BLAS at one thread
   while micro's own solves run (threadpoolctl), and gives the previous limits back after.
   BLAS thread counts are process-wide: the first block entered sets the limit and the
@@ -14,8 +15,8 @@ under load than alone (issue 39, rows 6 and 13):
 
 * **numba.**  The cohort kernels sum their cohorts with ``prange`` on numba's OpenMP
   threads, which spin at each of the thousands of joins in a run; with a thread
-  descheduled by another process the others spin until it comes back (two runs at once
-  on 2 cores: 15 to 160 s each against 2.7 s alone).  :func:`use_free_cores` sets the
+  descheduled by another process the others spin until it comes back (one cohort cycle
+  beside other busy processes: 49 s of CPU for 6 s of work, three at once 98 s each).  :func:`use_free_cores` sets the
   calling thread's numba thread count to the cores free to this process
   (:func:`numba_threads`): the processors in its affinity mask less the runnable
   threads of other processes (``/proc/loadavg`` less this process's own running

@@ -32,8 +32,8 @@ a 1-D map whose fixed point Newton's method finds (it reproduces Eq. (4)).
 
 Threads: the systems are small (32 to 384 unknowns) and solved thousands of times in a
 growth-rate root, where multithreaded BLAS gains nothing and its waiting threads spin
-against other work (``steady_sliding(Model(k0=0.1), np.logspace(-1, 3, 100))``: 1.2 s
-alone, 101 s under a load of 4).  Every public function here runs with BLAS held at one
+against other work (``steady_sliding(Model(k0=0.1), np.logspace(-1, 3, 100))`` under
+load: 6.4 s before, 1.1 s with one thread; three at once 64 s and 2.0 s each).  Every public function here runs with BLAS held at one
 thread (:func:`micro._threads.single_blas_thread`), the previous limits restored after.
 """
 from __future__ import annotations
