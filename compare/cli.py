@@ -36,7 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "shows the paper's five)")
     p.add_argument("--eps", type=float, help="micro bin eps > 0 (smaller: more accurate, cost ~ eps^-2.6)")
     p.add_argument("--dc", type=float, metavar="DC", help="use this D_c > 0 instead of fitting it")
-    p.add_argument("--workers", type=int, help="local worker processes >= 1 (default: all cores; 1: serial)")
+    p.add_argument("--workers", type=int, help="local worker processes >= 1 (default: the cores this process may use; 1: serial)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="dask.distributed scheduler address, e.g. tcp://host:8786 (needs the 'dask' extra)")
     p.add_argument("--cache-dir", metavar="DIR",
