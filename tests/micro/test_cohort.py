@@ -31,6 +31,9 @@ def test_state_after_a_total_shock_has_branching_ratio_one_minus_k0_over_kappa()
     assert dH == pytest.approx(-model.k0 / model.kappa, rel=1e-6)
 
 
+# (26 s alone on 2 idle cores: slow, so that the default run stays within 5 minutes; the
+# cohort rows' discretisation error in the default run is checked by tests/micro/test_api.py)
+@pytest.mark.slow
 def test_steady_sliding_stepped_by_cohorts_converges_in_dt_with_order_two_to_the_renewal_chain():
     """k0 = 0.3, V = 1 (about 5 V^c: steady sliding is stable), from the product state,
     stepped to t = 4 at dt = 0.04 and 0.02: the stress against the renewal chain's steady
