@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from typing import ClassVar, Union
 
 from .grid import GridSettings
-from .params import Model
+from .params import Model, _number
 
 __all__ = ["FP", "Numerics", "Cohort", "Renewal", "Auto", "Convergence", "METHODS", "resolve", "default_eps",
            "check_velocity"]
@@ -38,10 +38,9 @@ def _no_bool(obj, names, prefix: str = "") -> None:
 
 
 def check_velocity(V: float, name: str = "V") -> float:
-    """``V`` as a finite float > 0, or one ValueError naming it."""
-    if isinstance(V, bool) or not isinstance(V, (int, float)) and not hasattr(V, "__float__"):
-        raise ValueError(f"{name} must be a number > 0, got {V!r}")
-    V = float(V)
+    """``V`` as a finite float > 0, or one ValueError naming it (not a bool or a string:
+    the model's own number check)."""
+    V = _number(name, V)
     if not (math.isfinite(V) and V > 0.0):
         raise ValueError(f"{name} must be a finite number > 0, got {V:g}")
     return V
