@@ -34,6 +34,7 @@ import logging
 import math
 import numbers
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Sequence, Union
 
@@ -312,9 +313,20 @@ class NBlockResult:
     def success(self) -> bool:
         return self.status in ("completed", "shock_limit")
 
-    def to_dataframe(self) -> pd.DataFrame:
-        """The time series ``t, w, sigma, ...`` as a pandas DataFrame."""
+    def to_frame(self) -> pd.DataFrame:
+        """The time series ``t, w, sigma, ...`` as a pandas DataFrame (a copy of
+        :attr:`timeseries`)."""
         return self.timeseries.copy()
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """Deprecated alias of :meth:`to_frame` (the name every other result uses).
+
+        .. deprecated:: 0.1.0
+           Use :meth:`to_frame`.
+        """
+        warnings.warn("NBlockResult.to_dataframe is deprecated, use NBlockResult.to_frame",
+                      DeprecationWarning, stacklevel=2)
+        return self.to_frame()
 
 
 # ---------------------------------------------------------------------------------------
