@@ -661,14 +661,10 @@ def fit_power_law(V, amplitude, *, Vc: float | None = None) -> PowerLawFit:
         Vc = positive("Vc", Vc)
         if np.any(V >= Vc):
             raise ValueError(f"Vc must be > every V (largest V = {float(V.max())!r}), got {Vc!r}")
-        x, y = np.log(Vc - V), np.log(amp)
-        X = np.column_stack([np.ones_like(x), x])
-        coef, *_ = np.linalg.lstsq(X, y, rcond=None)
-        r = y - X @ coef
-        s2 = float(r @ r) / (x.size - 2)
-        cov = np.linalg.inv(X.T @ X) * s2
-        return PowerLawFit(float(coef[1]), float(math.sqrt(cov[1, 1])), float(math.exp(coef[0])), Vc, 0.0, False,
-                           int(x.size), float(math.sqrt(np.mean(r * r))))
+        # the linear fit in log-log is rsf's (the same least squares; compare builds on rsf)
+        beta, beta_err, c, _ = rsf.fit_power_law(Vc - V, amp)
+        r = np.log(amp) - (math.log(c) + beta * np.log(Vc - V))
+        return PowerLawFit(beta, beta_err, c, Vc, 0.0, False, int(V.size), float(math.sqrt(np.mean(r * r))))
     vmax = float(V.max())
     span = float(V.max() - V.min()) or vmax
 
