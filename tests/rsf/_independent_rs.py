@@ -11,10 +11,12 @@ so that :math:`(a + \\eta v)\\,\\dot{(\\ln v)} = k_0(V - v) - \\sum_i b_i\\,\\do
 """
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 
 def _theta_ss(law: str, v: float, Dc: float) -> float:
@@ -117,3 +119,105 @@ def mu_at(law: str, *, velocities, times, t_eval: np.ndarray, **kw) -> np.ndarra
         return vel[max(int(np.searchsorted(times, t, side="right")) - 1, 0)]
 
     return reference(law, velocity=velocity, breaks=times[1:], t_eval=t_eval, **kw)["mu"]
+
+
+# ------------------------------------------------------------------------------------------------
+# a = 0 with the paper's Eq. (10): the stick-slip cycle of Eq. (11), phase by phase
+# ------------------------------------------------------------------------------------------------
+def eq11_cycle(*, A: float, B: float, mu_inf: float, k0: float, Dc: float, V: float,
+               rtol: float = 1e-13, max_cycles: int = 100000) -> dict:
+    """The attractor of the a = 0 spring-slider with Eq. (10), mu_ss = mu_inf + A/(v + B), and the
+    aging law, reached from steady sliding at V with theta x 1.001 (as rsf.limit_cycle starts).
+
+    With a = 0 the friction is phi(theta) = mu_ss(Dc/theta) = mu_inf + A theta/(Dc + B theta), and
+    with u = Dc/theta, K = k0 Dc, W(u) = A u/(u + B)^2, N = K V - u W(u), D = K - W(u) the motion
+    on the threshold sigma = phi(theta) is, here solved phase by phase with no ODE integrator:
+
+    * N < 0, stick (v = 0, theta = theta0 + t, sigma = phi(theta0) + k0 V t): phi is concave, so
+      sigma - phi vanishes once more, at t = (A Dc/(k0 V (Dc + B theta0)) - Dc - B theta0)/B;
+    * N > 0, D < 0, instantaneous slip (theta = theta0 e^-s, sigma = phi(theta0) - K s): it lands
+      at the root of g(s) = phi(theta0) - phi(theta0 e^-s) - K s beyond the top of its hump,
+      s1 = ln(u+/u0) with u+ the upper root of W(u) = K (scipy's brentq);
+    * N > 0, D > 0, slide along the threshold: u moves monotonically to V, and the slide ends at
+      the first root of N (a stick) or D (a slip) between u and V, or settles on V (steady).
+
+    sigma moves monotonically in each phase, so its extrema are at the phase ends.  The cycle
+    (slip landing to slip landing) is iterated to the fixed point of the landing theta (relative
+    change < ``rtol``).  Returns ``regime`` ('steady' or 'stick-slip'), ``sigma_max``,
+    ``sigma_min``, ``n_cycles`` and ``sequence`` (the phases of the last cycle)."""
+    K = k0 * Dc
+
+    def rel(theta):                      # phi(theta) - mu_inf
+        return A * theta / (Dc + B * theta)
+
+    def drop(t1, t2):                    # phi(t1) - phi(t2), without cancellation
+        return A * Dc * (t1 - t2) / ((Dc + B * t1) * (Dc + B * t2))
+
+    def W(theta):                        # W(u) at u = Dc/theta (theta may underflow to 0)
+        return A * Dc * theta / (Dc + B * theta) ** 2
+
+    def uW(theta):
+        return A * Dc * Dc / (Dc + B * theta) ** 2
+
+    disc = (A - 2 * K * B) ** 2 - 4 * K * K * B * B
+    roots_D = []                         # W(u) = K: K u^2 + (2 K B - A) u + K B^2 = 0
+    if disc > 0 and A > 2 * K * B:
+        roots_D = [((A - 2 * K * B) - math.sqrt(disc)) / (2 * K), ((A - 2 * K * B) + math.sqrt(disc)) / (2 * K)]
+    r = math.sqrt(K * V / A)             # N = 0: u / (u + B) = r
+    root_N = B * r / (1.0 - r) if r < 1.0 else math.inf
+
+    def stick(theta):
+        return theta + (A * Dc / (k0 * V * (Dc + B * theta)) - Dc - B * theta) / B
+
+    def slip(theta):
+        s1 = math.log(roots_D[1] * theta / Dc)
+        if not s1 > 0.0:
+            raise RuntimeError(f"slip with no hump at u = {Dc / theta!r} (u+ = {roots_D[1]!r})")
+        g = lambda s: drop(theta, theta * math.exp(-s)) - K * s  # noqa: E731
+        s_hi = s1 + rel(theta) / K + 1.0
+        s = brentq(g, s1, s_hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
+        return theta * math.exp(-s)
+
+    def slide_end(theta):                # theta moves monotonically to Dc/V
+        lo, hi = sorted((theta, Dc / V))
+        inside = [(abs(x - theta), x, kind) for x, kind in
+                  [(Dc / root_N, "stick")] + [(Dc / x, "slip") for x in roots_D] if lo < x < hi]
+        if not inside:
+            return None, "steady"
+        _, x, kind = min(inside)
+        return x, kind
+
+    theta = 1.001 * Dc / V
+    phases: list[str] = []
+    visited: list[float] = []            # theta at the phase ends of the current cycle
+    landing = math.nan
+    for n_cycles in range(max_cycles + 1):
+        for _ in range(64):              # at most a few phases per cycle
+            N, D = K * V - uW(theta), K - W(theta)
+            if N < 0.0:
+                theta, kind = stick(theta), "stick"
+            elif D < 0.0:
+                theta, kind = slip(theta), "slip"
+            else:
+                end, then = slide_end(theta)
+                if end is None:
+                    s = mu_inf + A / (V + B)
+                    return {"regime": "steady", "sigma_max": s, "sigma_min": s, "n_cycles": n_cycles,
+                            "sequence": tuple(phases + ["slide"])}
+                phases.append("slide")
+                visited.append(end)
+                # the slide ends exactly on a root of N or D: that phase follows (the sign of
+                # N or D there is round-off)
+                theta, kind = (stick(end), "stick") if then == "stick" else (slip(end), "slip")
+            phases.append(kind)
+            visited.append(theta)
+            if kind == "slip":
+                break
+        else:
+            raise RuntimeError("no slip in 64 phases")
+        if abs(theta - landing) <= rtol * theta:     # (never true while landing is NaN)
+            return {"regime": "stick-slip", "sigma_max": mu_inf + rel(max(visited)),
+                    "sigma_min": mu_inf + rel(min(visited)), "n_cycles": n_cycles, "sequence": tuple(phases)}
+        landing = theta
+        phases, visited = [], [theta]
+    raise RuntimeError(f"no fixed point of the landing map in {max_cycles} cycles")
