@@ -79,6 +79,29 @@ class HopfFit:
     :math:`\ln(\sigma_{max}-\sigma_{min})` on :math:`\ln(V^c - V)` over the points with
     :math:`(V^c - V)/V^c \le` ``fit_max``; ``local_exponents`` are the slopes between
     neighbouring points (they show where the scaling holds).
+
+    Attributes
+    ----------
+    k0 : float
+        The driving stiffness of the model.
+    Vc : float
+        Its critical velocity (:func:`~rsf.critical_velocity`).
+    epsilon : ndarray
+        The relative distances :math:`(V^c - V)/V^c` measured, as given.
+    amplitude, sigma_min, sigma_max : ndarray
+        :math:`\sigma_{max} - \sigma_{min}` and the extrema of the limit cycle at each
+        epsilon.
+    exponent, exponent_stderr : float
+        The fitted :math:`\beta` and its standard error.
+    prefactor : float
+        The fitted :math:`c` in :math:`c\,(V^c - V)^\beta`.
+    fit_max : float
+        The largest epsilon that entered the fit.
+    local_exponents : ndarray
+        :math:`\mathrm{d}\ln A/\mathrm{d}\ln(V^c - V)` between neighbouring points, in
+        increasing :math:`V^c - V` (one fewer than the points).
+    converged : bool
+        Whether every limit cycle converged to a stick-slip cycle.
     """
 
     k0: float
@@ -108,13 +131,35 @@ def hopf_scaling(model: SpringSlider, epsilon: Sequence[float] | None = None, *,
     Parameters
     ----------
     model : SpringSlider
+        The slider; it must have a finite critical velocity :math:`V^c > 0`.
     epsilon : sequence of float, optional
-        Relative distances below Vc, in (0, 1); default 12 values from 1e-7 to 1e-1.
+        Relative distances below Vc, in (0, 1); default 13 values from 1e-7 to 1e-1
+        (geometric).
     fit_max : float
         Only points with epsilon <= fit_max enter the fit (default 1e-4: the scaling
-        region next to the bifurcation).
+        region next to the bifurcation); at least 3 must.
     options : SolverOptions, optional
-        Default: cycle_rtol = 1e-11 (the amplitude at epsilon = 1e-7 is ~1e-4 of sigma).
+        Default: cycle_rtol = 1e-11, rtol = 1e-12, atol = 1e-14 (the amplitude at
+        epsilon = 1e-7 is ~1e-4 of sigma).
+
+    Returns
+    -------
+    HopfFit
+        The amplitudes, the fitted exponent and prefactor and the local exponents;
+        ``converged`` is False if a limit cycle did not converge to stick-slip.
+
+    Raises
+    ------
+    ValueError
+        If the model has no finite critical velocity, ``epsilon`` holds a value outside
+        (0, 1), or fewer than 3 points have epsilon <= ``fit_max``.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> fit = rsf.hopf_scaling(rsf.SpringSlider(k0=0.3), [1e-6, 1e-5, 1e-4])
+    >>> round(fit.exponent, 3)
+    0.5
     """
     cv = critical_velocity(model)
     if not (math.isfinite(cv.Vc) and cv.Vc > 0):

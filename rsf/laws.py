@@ -70,6 +70,34 @@ def paper_mu_inf(k0: float, f_th: float = 1.0, zbar: float = 0.1, k1: float = 0.
 
     With the paper's constants (:math:`f^{th} = 1`, :math:`\bar z = 0.1`, :math:`k_1 = 0.1`,
     :math:`k_2 = 0.9`) this is :math:`0.95 - 0.05\,k_0`.
+
+    Parameters
+    ----------
+    k0 : float
+        Driving stiffness, >= 0.
+    f_th : float
+        Pinning threshold, finite (paper: 1).
+    zbar : float
+        Mean well spacing, > 0 (paper: 0.1).
+    k1, k2 : float
+        Elastic and viscoelastic couplings, >= 0 (paper: 0.1, 0.9).
+
+    Returns
+    -------
+    float
+        :math:`\mu_\infty` (it may be negative for a stiff spring; :class:`HyperbolicLaw`
+        refuses that).
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range.
+
+    Examples
+    --------
+    >>> from rsf.laws import paper_mu_inf
+    >>> paper_mu_inf(0.1)
+    0.945
     """
     nonnegative("k0", k0)
     return finite("f_th", f_th) - 0.5 * positive("zbar", zbar) * (
@@ -84,7 +112,18 @@ def _as_velocity_array(v: object) -> np.ndarray:
 
 
 class SteadyStateLaw:
-    """Base class of the steady-state laws (see the module docstring)."""
+    """Base class of the steady-state laws (see the module docstring).
+
+    Not used directly: a law is one of its subclasses, which :class:`~rsf.params.SpringSlider`
+    takes as ``law``.  Every law has the numpy methods :meth:`mu_ss`, :meth:`dmu_ss` and
+    :meth:`weakening` (velocities >= 0, vectorised; a negative or non-finite velocity
+    raises ValueError) and the solver's interface (``kernel_params``, :meth:`kernels`,
+    ``mu_ref``, :meth:`bind`).
+
+    See Also
+    --------
+    HyperbolicLaw, ViscoelasticLaw, LogLaw, TabulatedLaw, CallableLaw
+    """
 
     #: A short name used in tables and logs.
     name: str = "law"
@@ -176,6 +215,19 @@ class HyperbolicLaw(SteadyStateLaw):
         Large-velocity friction.  ``None`` means the paper's value for the driving stiffness,
         :math:`\mu_\infty = f^{th} - \bar z (k_0 + k_1 + k_2)/2` (:func:`paper_mu_inf`),
         resolved by :meth:`bind` (which :class:`~rsf.params.SpringSlider` calls).
+
+    Raises
+    ------
+    ValueError
+        If ``A`` is negative, ``B`` is not a finite number > 0 or ``mu_inf`` is not finite;
+        :meth:`bind` if the default ``mu_inf`` is not positive (k0 >= 19).
+
+    Examples
+    --------
+    >>> from rsf.laws import HyperbolicLaw
+    >>> law = HyperbolicLaw().bind(0.1)             # mu_inf = 0.95 - 0.05 k0 = 0.945
+    >>> round(float(law.mu_ss(1.0)), 6)
+    0.951494
     """
 
     A: float = PAPER_A
@@ -267,6 +319,12 @@ class ViscoelasticLaw(SteadyStateLaw):
         Dashpot viscosity, > 0 (paper: 1).
     k0 : float or None
         Driving stiffness entering the offset; ``None`` is resolved by :meth:`bind`.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range, or ``k0`` makes the large-velocity friction
+        :math:`f^{th} - \bar z(k_0 + k_1 + k_2)/2` non-positive.
     """
 
     f_th: float = 1.0
@@ -376,6 +434,12 @@ class LogLaw(SteadyStateLaw):
         Direct-effect and evolution-effect coefficients, >= 0.
     v0 : float
         Reference velocity, > 0.
+
+    Raises
+    ------
+    ValueError
+        If ``mu0`` is not finite, ``a`` or ``b`` is negative, or ``v0`` is not a finite
+        number > 0.
     """
 
     mu0: float = 0.6
@@ -543,6 +607,20 @@ class TabulatedLaw(SteadyStateLaw):
         Velocities, > 0, at least two distinct values (sorted on construction).
     mu : array_like
         Friction values, finite, same length as ``V``.
+
+    Raises
+    ------
+    ValueError
+        If ``V`` and ``mu`` differ in length, fewer than 2 velocities are given, a velocity
+        is not finite and > 0, a friction is not finite, or a velocity repeats.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rsf.laws import TabulatedLaw
+    >>> law = TabulatedLaw([0.1, 1.0, 10.0], [0.96, 0.95, 0.94])
+    >>> law.mu_ss(np.array([1.0, 100.0]))        # held flat beyond the table
+    array([0.95, 0.94])
     """
 
     V: np.ndarray
@@ -716,6 +794,21 @@ class CallableLaw(SteadyStateLaw):
     w_range : tuple of float or None
         Bounds of :math:`W = -v\mu_{ss}'` over v > 0; if None they are estimated on a grid
         from 1e-12 to 1e12 with a 50 % margin.
+
+    Raises
+    ------
+    ValueError
+        If either function is not callable, gives a non-finite value at a probe velocity
+        in [1e-6, 1e6], the derivative does not match central differences of ``mu_ss_fn``
+        there, or ``w_range`` is not a finite (low, high) with low <= high.
+
+    Examples
+    --------
+    >>> from rsf.laws import CallableLaw
+    >>> law = CallableLaw(lambda v: 0.945 + 0.007 / (v + 0.078),    # Eq. (10) again
+    ...                   lambda v: -0.007 / (v + 0.078) ** 2, label="eq10")
+    >>> round(float(law.weakening(1.0)), 6)                         # A v / (v + B)^2
+    0.006024
     """
 
     mu_ss_fn: Callable[[float], float]

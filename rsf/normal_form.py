@@ -285,6 +285,8 @@ class HopfNormalForm:
         The critical driving velocity (with ``parameter='k0'``: the V given).
     k0c : float
         The critical stiffness (with ``parameter='V'``: the model's k0).
+    a, Dc : float
+        The model's direct effect and critical slip distance.
     parameter : str
         ``'V'``: :math:`d = (V^c - V)/V^c`; ``'k0'``: :math:`d = (k_0^c - k_0)/k_0^c`.
     omega : float
@@ -315,6 +317,10 @@ class HopfNormalForm:
     method : str
         ``'closed form'`` (with ``(W' and W'' by differences)`` for a law other than the
         log law and Eq. 10) or ``'finite differences'``.
+    law, state_law : str
+        The names of the model's steady-state and state laws.
+    eta_rad : float
+        The model's radiation damping.
     """
 
     Vc: float
@@ -409,6 +415,26 @@ def hopf_normal_form(model: SpringSlider, *, parameter: str = "V", V: float | No
     Returns
     -------
     HopfNormalForm
+        The frequency, the first Lyapunov coefficient and its error, the kind
+        (super-, subcritical or degenerate), the side of the critical point where the
+        cycle exists and the amplitude prefactor :math:`c` of :math:`c\,|d|^{1/2}`.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`~rsf.params.SpringSlider`, :math:`a = 0`,
+        ``parameter`` or ``method`` is not one of its choices, ``V`` is given with
+        ``parameter='V'`` or missing with ``'k0'``, the model has no finite critical
+        velocity (``parameter='V'``) or no critical stiffness in [1e-12, 1e6]
+        (``parameter='k0'``), the critical eigenvalues are not a pair on the imaginary
+        axis, or ``method='closed form'`` is asked for a model it does not cover.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> nf = rsf.hopf_normal_form(rsf.SpringSlider(k0=0.1, a=1e-3))
+    >>> nf.kind, nf.side
+    ('supercritical', 'd > 0')
     """
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
@@ -539,9 +565,12 @@ class StickSlipNormalForm:
     Attributes
     ----------
     Vc, k0, Dc, K : float
+        The critical velocity, the stiffness, the critical slip distance and
+        :math:`K = k_0 D_c`.
     omegas : tuple of float
-        :math:`\Omega_1 \dots \Omega_4` (``omega_method``: 'closed form' or 'finite
-        differences').
+        :math:`\Omega_1 \dots \Omega_4`.
+    omega_method : str
+        How they were computed: 'closed form' or 'finite differences'.
     prefactor : float
         :math:`c_0` (nan unless :math:`\Omega_1 > \Omega_2 > -\infty` and
         :math:`\Omega_1 > 0`).
@@ -553,6 +582,8 @@ class StickSlipNormalForm:
     kind : str
         ``'supercritical'`` (:math:`\Omega_1 > \Omega_2`: a small cycle below V^c) or
         ``'no small cycle'``.
+    model : SpringSlider
+        The model, for :meth:`cycle`.
     """
 
     Vc: float
@@ -643,7 +674,32 @@ def stick_slip_normal_form(model: SpringSlider) -> StickSlipNormalForm:
     prefactor :math:`c_0` and correction :math:`c_2` of
     :math:`\sigma_{max} - \sigma_{min} = c_0 d^{1/2}(1 + c_2 d)`, and the exact cycle
     (:meth:`StickSlipNormalForm.cycle`).  (For a > 0 the same formulas give the
-    :math:`a \to 0` limit taken before :math:`d \to 0`.)"""
+    :math:`a \to 0` limit taken before :math:`d \to 0`.)
+
+    Parameters
+    ----------
+    model : SpringSlider
+        The slider; only its steady-state law, ``k0`` and ``Dc`` enter.
+
+    Returns
+    -------
+    StickSlipNormalForm
+        :math:`V^c`, :math:`\Omega_1 \dots \Omega_4`, :math:`c_0`, :math:`c_2`, the
+        period's prefactor and the kind (prefactors nan where there is no small cycle).
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`~rsf.params.SpringSlider` or has no finite critical
+        velocity.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> nf = rsf.stick_slip_normal_form(rsf.SpringSlider(k0=0.1))
+    >>> nf.kind, round(nf.Vc, 4)
+    ('supercritical', 1.0046)
+    """
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     Vc = critical_velocity(model.law, k0=model.k0, Dc=model.Dc).Vc
@@ -677,6 +733,30 @@ def transition_spectrum(model: SpringSlider, d: Sequence[float]) -> pd.DataFrame
     slide :math:`\dot\delta = \alpha K\delta/(W - K)`, :math:`\alpha = V/D_c`, which is
     ``growth_rate`` (it diverges as :math:`1/d`).  Columns: d, V, growth_rate, frequency,
     other_rate, fast_rate, and the same rates in units of :math:`V/D_c` (suffix ``_tau``).
+
+    Parameters
+    ----------
+    model : SpringSlider
+        The slider (any direct effect :math:`a \ge 0`).
+    d : sequence of float
+        Relative distances below the critical velocity, :math:`d = (V^c - V)/V^c`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per d: k0, a, d, V, the rates per unit time and per :math:`V/D_c`.
+
+    Raises
+    ------
+    ValueError
+        If the model has no finite critical velocity.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> sp = rsf.transition_spectrum(rsf.SpringSlider(k0=0.1), [0.01, 0.1])
+    >>> bool(sp.growth_rate.iloc[0] > sp.growth_rate.iloc[1])     # diverges as 1/d for a = 0
+    True
     """
     d = np.atleast_1d(np.asarray(d, dtype=float))
     cv = critical_velocity(model) if model.a > 0.0 else critical_velocity(model.law, k0=model.k0, Dc=model.Dc)
@@ -717,7 +797,34 @@ def classify_spectrum(spectrum: pd.DataFrame, periods: pd.DataFrame | None = Non
     entering from infinity), else it vanishes as at a local bifurcation.  ``periods``
     (optional): columns d and period of the born cycle; the slope of ln period against ln d
     is ``period_exponent``.  Hopf: not diverging and :math:`|` period_exponent :math:`| <
-    0.25` (a finite frequency).  Returns the numbers, ``hopf`` (bool) and ``text``."""
+    0.25` (a finite frequency).
+
+    Parameters
+    ----------
+    spectrum : pandas.DataFrame
+        Columns ``d`` and ``growth_rate`` (and ``frequency``, optional).
+    periods : pandas.DataFrame, optional
+        Columns ``d`` and ``period``; the period exponent needs at least 3 finite periods > 0.
+
+    Returns
+    -------
+    dict
+        ``d_near``, ``growth_near``, ``d_far``, ``growth_far`` (``frequency_near``),
+        ``growth_diverges``, with periods ``period_exponent`` and ``d_period`` (its range
+        of d), ``hopf`` (bool) and ``text``, a sentence with the verdict.
+
+    Raises
+    ------
+    ValueError
+        If the spectrum has fewer than two finite growth rates.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> out = rsf.classify_spectrum(rsf.transition_spectrum(rsf.SpringSlider(k0=0.1), [1e-3, 0.5]))
+    >>> out["growth_diverges"], out["hopf"]
+    (True, False)
+    """
     out: dict = {}
     sp = spectrum[np.isfinite(spectrum.growth_rate)].sort_values("d")
     if len(sp) < 2:
@@ -760,7 +867,35 @@ def cycle_near_hopf(model: SpringSlider, V: float, *, guess: float | None = None
     The result is :func:`rsf.limit_cycle` started on that fixed point (converged in a
     few cycles), a :class:`~rsf.CycleResult`.
 
-    ``guess``: a first y at the section (default: from :func:`hopf_normal_form`).
+    Parameters
+    ----------
+    model : SpringSlider
+        With a direct effect :math:`a > 0` and one state variable.
+    V : float
+        Driving velocity, > 0, on the side of the Hopf point where the cycle exists.
+    guess : float, optional
+        A first y at the section (default: from :func:`hopf_normal_form`).
+    options : SolverOptions, optional
+        Default: cycle_rtol = 1e-11, rtol = 1e-12, atol = 1e-14.
+    tol : float
+        Absolute tolerance of the secant iteration in y (default 1e-13).
+    max_iter : int
+        Secant steps at most (default 40).
+    max_cycles : int
+        Cycles at most of the final :func:`rsf.limit_cycle` (default 200).
+
+    Returns
+    -------
+    CycleResult
+        The limit cycle at ``V``, from :func:`rsf.limit_cycle` started on the fixed point.
+
+    Raises
+    ------
+    ValueError
+        If :math:`a = 0`, the model has a second state variable, ``V`` is not a finite
+        number > 0, or (without ``guess``) :func:`hopf_normal_form` refuses the model.
+    RuntimeError
+        If a run from the section finds no minimum of :math:`\sigma`.
     """
     if model.a == 0.0 or model.second_state is not None:
         raise ValueError("cycle_near_hopf needs a > 0 and one state variable")

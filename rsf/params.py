@@ -73,6 +73,24 @@ class SpringSlider:
         :math:`a > 0`): the force balance reads
         :math:`k_0(X(t) - x) = \mu(v, \theta) + \eta_{rad}\,v` (with :math:`F_N = 1`).
         Default 0, the paper's model.
+
+    Raises
+    ------
+    ValueError
+        If ``law`` is not a steady-state law, ``k0`` or ``Dc`` is not a finite number > 0,
+        ``a`` or ``eta_rad`` is negative, the state law is unknown, or the parts do not fit
+        together: a state law other than aging, ``eta_rad > 0`` or a second state with
+        :math:`a = 0`; a user state law whose steady state is not :math:`\theta = D_c/v`;
+        ``NagataLaw(b=None)`` or a second state without a :class:`~rsf.laws.LogLaw`; a
+        second state with the Nagata or a user law; the default ``mu_inf`` of Eq. (10)
+        negative (k0 >= 19).
+
+    Examples
+    --------
+    >>> import rsf
+    >>> model = rsf.SpringSlider(k0=0.1)          # the paper's Eq. (10), Dc = 0.06, a = 0
+    >>> round(model.K, 6), round(model.sigma_steady(1.0), 6)
+    (0.006, 0.951494)
     """
 
     law: SteadyStateLaw = field(default_factory=HyperbolicLaw)
@@ -162,6 +180,44 @@ def standard_rs(mu0: float = 0.6, a: float = 0.01, b: float = 0.015, Dc: float =
               \;[+\, b_2\ln(\theta_2 v_0/D_{c2})].
 
     Defaults are laboratory-like (SI units: m, s), as in rsfmodel's examples.
+
+    Parameters
+    ----------
+    mu0 : float
+        Friction at the reference velocity ``v0`` in steady state.
+    a, b : float
+        Direct-effect and evolution-effect coefficients, >= 0 (``a`` is also the model's
+        direct effect).
+    Dc : float
+        Critical slip distance, > 0.
+    k0 : float
+        Spring stiffness (per unit normal stress), > 0.
+    v0 : float
+        Reference velocity, > 0.
+    state_law : {'aging', 'slip', 'prz', 'nagata'}, StateLaw or callable
+        The state evolution; see :class:`SpringSlider`.
+    second_state : SecondState, optional
+        A second state variable with its own ``b2`` and ``Dc2``.
+    eta_rad : float
+        Radiation damping, >= 0.
+
+    Returns
+    -------
+    SpringSlider
+        With ``law=LogLaw(mu0, a, b, v0)`` and the direct effect ``a``.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of range or the combination is refused by
+        :class:`SpringSlider` (for instance ``a = 0`` with a state law other than aging).
+
+    Examples
+    --------
+    >>> import rsf
+    >>> cv = rsf.critical_velocity(rsf.standard_rs(b=0.025))   # b - a > k0 Dc = 0.01
+    >>> cv.Vc, cv.status
+    (inf, 'unstable at large V')
     """
     return SpringSlider(law=LogLaw(mu0=mu0, a=a, b=b, v0=v0), k0=k0, Dc=Dc, a=a,
                         state_law=state_law, second_state=second_state, eta_rad=eta_rad)
@@ -178,6 +234,30 @@ class Protocol:
 
     Build it with :meth:`constant`, :meth:`velocity_steps`, :meth:`slide_hold_slide` or
     :meth:`sampled`.
+
+    Parameters
+    ----------
+    times : array_like
+        Sample times, finite and strictly increasing, starting at 0.
+    velocities : array_like
+        Load-point velocities at those times, finite and >= 0, as many as ``times``.
+    interpolation : {'previous', 'linear'}
+        Piecewise-constant steps (default) or linear interpolation between the samples
+        (needs a direct effect :math:`a > 0` in :func:`~rsf.simulate`).
+
+    Raises
+    ------
+    ValueError
+        If ``times`` and ``velocities`` are empty or of different lengths, ``times[0]`` is
+        not 0, the times are not finite and strictly increasing, a velocity is negative or
+        not finite, or ``interpolation`` is neither 'previous' nor 'linear'.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> shs = rsf.Protocol.slide_hold_slide(1.0, slide_time=10.0, hold_time=100.0)
+    >>> shs.velocity_at(50.0), shs.velocity_at(120.0), float(shs.load_point(120.0))
+    (0.0, 1.0, 20.0)
     """
 
     times: np.ndarray
@@ -319,6 +399,12 @@ class InitialState:
         slide-hold-slide or sampled protocol, 1e-3 for constant driving and for the
         limit-cycle searches (:func:`~rsf.limit_cycle`, :func:`~rsf.sweep`), where the
         perturbation lets an unstable steady state depart.
+
+    Raises
+    ------
+    ValueError
+        If ``theta`` is not a finite number > 0, ``sigma`` is not a finite number, or
+        ``perturbation`` is not a finite number > -1.
     """
 
     theta: float | None = None
@@ -389,6 +475,19 @@ class SolverOptions:
         Step budget: a run (one :func:`~rsf.simulate` or :func:`~rsf.limit_cycle` call)
         stops with status ``STEP_BUDGET`` after this many right-hand-side evaluations of
         CVODE in total (default 20,000,000, minutes of run time), so that no input hangs.
+
+    Raises
+    ------
+    ValueError
+        If a tolerance lies outside its range, a count is not an integer >= 1,
+        ``accelerate`` is not a bool, ``method`` is neither 'Adams' nor 'BDF', or
+        ``v_max`` is not a number > 0 (inf allowed).
+
+    Examples
+    --------
+    >>> import rsf
+    >>> rsf.SolverOptions(rtol=1e-8, cycle_rtol=1e-6).max_cycles
+    20000
     """
 
     rtol: float = 1e-10

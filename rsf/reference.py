@@ -185,7 +185,26 @@ def _slide(m: _Model, rho0: float) -> tuple[_Segment | None, float, str]:
 
 @dataclass
 class ReferenceCycle:
-    """One cycle from a slip landing to the next, or steady sliding."""
+    """One cycle from a slip landing to the next, or steady sliding.
+
+    Attributes
+    ----------
+    regime : str
+        ``'stick-slip'`` or ``'steady'``.
+    sigma_max, sigma_min, sigma_mean : float
+        Extrema and time average of the friction over the cycle.
+    period : float
+        Its duration.
+    sequence : tuple of str
+        Its phase switches, as :attr:`rsf.CycleResult.sequence`.
+    theta_landing, theta_next : float
+        The state at the landing it starts from and at the next landing.
+    fixed_point_residual : float
+        :math:`\ln\theta_{next} - \ln\theta_{landing}` at the end of
+        :func:`reference_cycle`'s iteration (nan for one map step).
+    extras : dict
+        Unused by rsf itself (empty).
+    """
 
     regime: str
     sigma_max: float
@@ -257,9 +276,42 @@ def reference_cycle(model: SpringSlider, V: float, theta_landing: float | None =
     r"""The limit cycle at velocity ``V`` as the fixed point of :func:`cycle_map`
     (the landing state :math:`\ln\theta_L` maps to the next landing).
 
-    Starts from ``theta_landing`` (default: the landing after the first slip from the
-    perturbed steady state), iterates the map, then solves :math:`P(x) = x` by the secant
+    Starts from ``theta_landing`` (default: the landing after the first slip from 5 %
+    above the steady state), iterates the map, then solves :math:`P(x) = x` by the secant
     method until the residual is below ``tol``.
+
+    Parameters
+    ----------
+    model : SpringSlider
+        A model without direct effect (:math:`a = 0`) whose law meets the shape
+        assumptions of the module docstring (:func:`check_assumptions`).
+    V : float
+        Driving velocity, > 0.
+    theta_landing : float, optional
+        The state at a slip landing to start from.
+    tol : float
+        Residual of the fixed point in :math:`\ln\theta`, relative to
+        :math:`\max(1, |\ln\theta|)` (default 1e-14).
+    max_iter : int
+        Secant steps at most (default 200); the last residual is returned either way.
+
+    Returns
+    -------
+    ReferenceCycle
+        The cycle (or ``regime='steady'`` if the motion settles into steady sliding), with
+        its ``fixed_point_residual``.
+
+    Raises
+    ------
+    ValueError
+        If the model has a direct effect :math:`a > 0`.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> ref = rsf.reference_cycle(rsf.SpringSlider(k0=0.1), 0.05)
+    >>> ref.regime, round(ref.sigma_max, 6), round(ref.period, 4)
+    ('stick-slip', 1.030897, 17.3286)
     """
     if model.a != 0.0:
         raise ValueError("the reference covers the a = 0 model only")

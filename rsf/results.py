@@ -84,7 +84,32 @@ def write_atomically(path: str | os.PathLike, write: Callable[[Path], None], *,
 
 
 class Status:
-    """Named outcomes (integers, like scipy's ``OdeResult.status``)."""
+    """Named outcomes (integers, like scipy's ``OdeResult.status``): values >= 0 are
+    successes, negative values failures; :data:`STATUS_MESSAGES` has the message of each.
+
+    Attributes
+    ----------
+    TIME_LIMIT : int
+        0, the run reached ``t_end``.
+    STEADY : int
+        1, steady sliding reached (a stable steady state within tolerance).
+    CONVERGED : int
+        2, the limit cycle converged.
+    MAX_CYCLES : int
+        -1, no converged limit cycle within ``SolverOptions.max_cycles``.
+    MAX_EVENTS : int
+        -2, more events than ``SolverOptions.max_events`` in one run.
+    RUNAWAY : int
+        -3, a slip that never arrests: for :math:`a > 0` the slip velocity passed
+        ``SolverOptions.v_max``; for :math:`a = 0` a slip whose weakening outruns the
+        spring without bound.
+    SOLVER_FAILED : int
+        -4, CVODE or a root search failed.
+    DEGENERATE : int
+        -5, repeated zero-length phases at a degenerate (tangent) point.
+    STEP_BUDGET : int
+        -6, the step budget ``SolverOptions.max_rhs_evals`` ran out.
+    """
 
     TIME_LIMIT = 0        #: reached t_end
     STEADY = 1            #: steady sliding reached (a stable steady state within tolerance)
@@ -114,7 +139,17 @@ STATUS_MESSAGES: dict[int, str] = {
 class Event:
     """A switch of phase (``kind`` like ``'stick->slip'``) or another marked instant
     (``'steady'``, ``'drive'``, ``'extremum'``, ``'restart'``, ``'sigma_max'``,
-    ``'sigma_min'``)."""
+    ``'sigma_min'``).
+
+    Attributes
+    ----------
+    t : float
+        Its time.
+    kind : str
+        What happened.
+    sigma, theta, x : float
+        Friction, state variable and slider position at that instant.
+    """
 
     t: float
     kind: str
@@ -183,6 +218,8 @@ class CycleResult:
 
     Attributes
     ----------
+    V : float
+        The driving velocity.
     regime : str
         ``'steady'`` or ``'stick-slip'`` (any converged oscillation), or ``'unknown'`` when
         the search failed.
@@ -193,8 +230,10 @@ class CycleResult:
         Duration of the last cycle (nan for steady sliding).
     converged : bool
         Whether the cycle (or the steady state) was reached within tolerance.
-    status, message
-        Outcome (:class:`Status`).
+    status : int
+        Outcome (:class:`Status`); ``success`` is ``status >= 0``.
+    message : str
+        Human-readable status.
     n_cycles : int
         Cycles simulated.
     relative_change : float
@@ -204,6 +243,10 @@ class CycleResult:
         Event kinds of the last cycle.
     events : list of Event
         Events of the last cycle.
+    params : dict
+        Model parameters and ``V``.
+    run_time : float
+        Wall time of the search, in seconds.
     """
 
     V: float
@@ -251,7 +294,17 @@ class CycleResult:
 
 @dataclass
 class SweepResult:
-    """Limit cycles over a list of driving velocities (:func:`rsf.sweep`)."""
+    """Limit cycles over a list of driving velocities (:func:`rsf.sweep`).
+
+    It is a sequence of its :class:`CycleResult` (``len``, iteration, indexing).
+
+    Attributes
+    ----------
+    results : list of CycleResult
+        One per velocity, in the order given.
+    params : dict
+        Model parameters.
+    """
 
     results: list[CycleResult]
     params: dict[str, Any] = field(default_factory=dict)

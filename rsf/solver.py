@@ -65,6 +65,7 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
         Default: the exact steady state at the first velocity for a protocol that changes
         the velocity; for constant driving the steady state with theta perturbed by 1e-3.
     options : SolverOptions, optional
+        Tolerances, budgets and the runaway bound; default ``SolverOptions()``.
     stop_at_steady : bool
         End the run as soon as a stable steady slide is reached (status ``STEADY``).
     t_eval : array_like, optional
@@ -78,7 +79,26 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     -------
     Trajectory
         ``t, x, sigma, theta, v`` samples, the events (time, kind, sigma, theta, x) and the
-        status.  A slip appears as two samples at one instant.
+        status.  A slip appears as two samples at one instant.  A run that cannot go on
+        (runaway, solver failure, the step budget, ``options.max_events``) is not an
+        exception: it returns what it computed with a negative ``status`` and its message
+        (and logs a warning).
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`~rsf.params.SpringSlider`, ``t_end`` is not in
+        (0, 1e8], both or neither of ``V`` and ``protocol`` are given, ``t_eval`` is not
+        finite, strictly increasing and within ``[0, t_end]``, a sampled (linear) protocol
+        is given for :math:`a = 0`, or the driving starts at V = 0 without
+        ``initial.theta``.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> run = rsf.simulate(rsf.SpringSlider(k0=0.1), V=0.5, t_end=20.0)
+    >>> run.success, list(run.to_frame().columns)
+    (True, ['t', 'x', 'sigma', 'theta', 'v'])
     """
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
@@ -148,13 +168,43 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
     cycles, with the same sequence of events, differ by less than ``options.cycle_rtol``
     (relative).  The run stops as soon as a stable steady slide is within
     ``cycle_rtol`` of the steady state.  With ``options.accelerate`` the cycle-to-cycle map
-    of :math:`\ln\theta` at the section is extrapolated (Aitken) to skip slow transients.
+    of :math:`\ln\theta` at the section is extrapolated (Aitken) to skip slow transients
+    (not with a second state variable, whose map has two dimensions).
+
+    Parameters
+    ----------
+    model : SpringSlider
+        The slider and its friction law.
+    V : float
+        Constant load-point velocity, > 0.
+    initial : InitialState, optional
+        Where the run starts; default the steady state at ``V`` with theta perturbed by
+        ``InitialState.DEFAULT_PERTURBATION`` (1e-3), so that an unstable steady state
+        departs.
+    options : SolverOptions, optional
+        ``cycle_rtol``, ``max_cycles``, ``accelerate`` and the integrator's tolerances;
+        default ``SolverOptions()``.
 
     Returns
     -------
     CycleResult
-        regime ('steady' or 'stick-slip'), sigma_max, sigma_min, sigma_mean, period,
-        converged, status and message.
+        regime ('steady', 'stick-slip', or 'unknown' if the search failed), sigma_max,
+        sigma_min, sigma_mean, period, converged, status and message.  A search that does
+        not converge returns ``converged=False`` with a negative status (and logs a
+        warning) rather than raising.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`~rsf.params.SpringSlider` or ``V`` is not a finite
+        number > 0.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> model = rsf.SpringSlider(k0=0.1)
+    >>> rsf.limit_cycle(model, 0.05).regime, rsf.limit_cycle(model, 2.0).regime
+    ('stick-slip', 'steady')
     """
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
@@ -201,9 +251,11 @@ def sweep(model: SpringSlider, velocities: Iterable[float], *, options: SolverOp
     Parameters
     ----------
     model : SpringSlider
+        The slider and its friction law.
     velocities : iterable of float
         Driving velocities, > 0.
     options : SolverOptions, optional
+        Passed to every :func:`limit_cycle`; default ``SolverOptions()``.
     initial : InitialState, optional
         Used at every velocity (default: perturbed steady state at that velocity).
     progress : bool
@@ -214,6 +266,19 @@ def sweep(model: SpringSlider, velocities: Iterable[float], *, options: SolverOp
     SweepResult
         ``to_frame()`` has one row per V: k0, Dc, V, regime, sigma_max, sigma_min,
         sigma_mean, period, converged, status, message, ...
+
+    Raises
+    ------
+    ValueError
+        If ``velocities`` is empty or holds a value that is not a finite number > 0, or
+        ``model`` is not a :class:`~rsf.params.SpringSlider`.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> table = rsf.sweep(rsf.SpringSlider(k0=0.1), [0.05, 2.0]).to_frame()
+    >>> list(table.regime)
+    ['stick-slip', 'steady']
     """
     vel = [positive(f"velocities[{i}]", v) for i, v in enumerate(velocities)]
     if not vel:

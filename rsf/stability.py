@@ -40,6 +40,7 @@ class CriticalVelocity:
     Attributes
     ----------
     k0, Dc : float
+        Driving stiffness and critical slip distance of the model.
     Vc : float
         The critical velocity: the largest V at which steady sliding turns unstable as V
         decreases (``inf`` if it is unstable at all large V, ``nan`` if it is stable at every
@@ -52,7 +53,10 @@ class CriticalVelocity:
     unstable : tuple of (float, float)
         The intervals of V where steady sliding is linearly unstable.
     method : str
-        'quadratic' (closed form for Eq. 10) or 'scan' (roots bracketed on a log grid).
+        'quadratic' (closed form for Eq. 10), 'constant W' (the log law, whose weakening
+        does not depend on V) or 'scan' (roots bracketed on a log grid).
+    params : dict
+        Unused by rsf itself (empty); not compared.
     """
 
     k0: float
@@ -198,11 +202,28 @@ def critical_velocity(law: SteadyStateLaw | None = None, k0: float = 0.01, Dc: f
     k0, Dc : float
         Driving stiffness and critical slip distance, > 0.
     v_min, v_max : float
-        Range scanned for roots of a general law (ignored for the closed forms).
+        Range scanned for roots of a general law (ignored for the closed forms), > 0 with
+        ``v_max > v_min``.
 
     Returns
     -------
     CriticalVelocity
+        ``Vc`` (nan if steady sliding is stable at every V, inf if unstable at all large
+        V), the lower end of its unstable band, every root and the unstable intervals.
+
+    Raises
+    ------
+    ValueError
+        If ``law`` is neither a steady-state law nor a spring-slider, ``k0``, ``Dc``,
+        ``v_min`` or ``v_max`` is not a finite number > 0, ``v_max <= v_min``, or the
+        default ``mu_inf`` of Eq. (10) is negative at ``k0`` (k0 >= 19).
+
+    Examples
+    --------
+    >>> import rsf
+    >>> cv = rsf.critical_velocity(k0=0.1, Dc=0.06)
+    >>> round(cv.Vc, 4), round(cv.V_lower, 4)
+    (1.0046, 0.0061)
     """
     if isinstance(law, SpringSlider):
         model = law

@@ -32,7 +32,16 @@ AGING, SLIP, PRZ, NAGATA, USER = 0, 1, 2, 3, 4
 
 
 class StateLaw:
-    """Base class: a state evolution law (see the module docstring)."""
+    """Base class: a state evolution law (see the module docstring).
+
+    Not used directly: :class:`~rsf.params.SpringSlider` takes a subclass, its name, or a
+    callable as ``state_law``.  Each law has a ``name``, the ``code`` the kernels
+    understand, and :meth:`rate`, :math:`\mathrm{d}\theta/\mathrm{d}t` in plain Python.
+
+    See Also
+    --------
+    AgingLaw, SlipLaw, PRZLaw, NagataLaw, CallableStateLaw
+    """
 
     name: str = "state"
     code: int = -1
@@ -52,7 +61,17 @@ class AgingLaw(StateLaw):
 
     .. math:: \dot\theta = 1 - \frac{v\theta}{D_c}.
 
+    It takes no parameters; ``state_law='aging'`` is the same.
+
+    References
+    ----------
     Dieterich, J. H. (1979), J. Geophys. Res. 84(B5), 2161-2168.
+
+    Examples
+    --------
+    >>> from rsf.state_laws import AgingLaw
+    >>> AgingLaw().rate(v=2.0, theta=0.03, Dc=0.06)     # steady at theta = Dc / v
+    0.0
     """
 
     name = "aging"
@@ -68,6 +87,11 @@ class SlipLaw(StateLaw):
 
     .. math:: \dot\theta = -\frac{v\theta}{D_c}\ln\frac{v\theta}{D_c}.
 
+    It takes no parameters; ``state_law='slip'`` is the same.  It needs a direct effect
+    :math:`a > 0`.
+
+    References
+    ----------
     Ruina, A. (1983), J. Geophys. Res. 88(B12), 10359-10370.
     """
 
@@ -91,6 +115,11 @@ class PRZLaw(StateLaw):
     :math:`\theta = \theta_{PRZ}/2`, whose steady state is :math:`D_c/v` as for the other
     laws: :math:`\dot\theta = \tfrac12\,[1 - (v\theta/D_c)^2]`.
 
+    It takes no parameters; ``state_law='prz'`` is the same.  It needs a direct effect
+    :math:`a > 0`.
+
+    References
+    ----------
     Perrin, G., Rice, J. R. & Zheng, G. (1995), J. Mech. Phys. Solids 43(9), 1461-1495.
     """
 
@@ -116,9 +145,16 @@ class NagataLaw(StateLaw):
     c : float
         Stress-weakening coefficient, >= 0 (Nagata et al. found c of about 2).
     b : float or None
-        The evolution effect :math:`b` in :math:`c/b`; None: the model's
-        :class:`~rsf.laws.LogLaw` ``b``.
+        The evolution effect :math:`b` in :math:`c/b`, > 0; None: the model's
+        :class:`~rsf.laws.LogLaw` ``b`` (then the model must have a log law).
 
+    Raises
+    ------
+    ValueError
+        If ``c`` is negative or not finite, or ``b`` is given and not a finite number > 0.
+
+    References
+    ----------
     Nagata, K., Nakatani, M. & Yoshida, S. (2012), J. Geophys. Res. 117, B02314.
     """
 
@@ -153,6 +189,20 @@ class CallableStateLaw(StateLaw):
     func : callable
         ``func(v, theta) -> dtheta/dt``.
     name : str
+        Its name in tables (default ``'user'``).
+
+    Raises
+    ------
+    ValueError
+        If ``func`` is not callable, or ``func(1.0, 1.0)`` fails or is not finite.
+        (:class:`~rsf.params.SpringSlider` also checks that the steady state is
+        :math:`\theta = D_c/v`.)
+
+    Examples
+    --------
+    >>> import rsf
+    >>> law = rsf.CallableStateLaw(lambda v, theta: 1.0 - v * theta / 0.06, name="aging, by hand")
+    >>> model = rsf.SpringSlider(rsf.LogLaw(), k0=0.01, Dc=0.06, state_law=law)
     """
 
     func: Callable[[float, float], float] = field(default=None)  # type: ignore[assignment]
@@ -204,6 +254,16 @@ class SecondState:
         Its evolution effect, > 0.
     Dc2 : float
         Its critical slip distance, > 0.
+
+    Raises
+    ------
+    ValueError
+        If ``b2`` or ``Dc2`` is not a finite number > 0.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> model = rsf.standard_rs(second_state=rsf.SecondState(b2=0.005, Dc2=1e-4))
     """
 
     b2: float
