@@ -17,7 +17,6 @@ V / V^c, dt and h: ``--k0 0.01`` alone adds its rows).
 from __future__ import annotations
 
 import argparse
-import time
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +25,8 @@ import pandas as pd
 import micro
 from micro.cohort import cycle_cohorts
 
-HERE = Path(__file__).resolve().parent
+from _harness import RESULTS, Stopwatch, warm_up, write_csv
+
 FRACTIONS = (0.5, 0.7, 0.8, 0.9, 0.95, 0.97, 0.98, 0.99, 0.995, 0.998, 0.999)
 
 
@@ -50,9 +50,7 @@ def save(rows: list[dict], out: Path) -> pd.DataFrame:
         old = old[~old.set_index(KEY).index.isin(frame.set_index(KEY).index)]
         frame = pd.concat([old, frame], ignore_index=True)
     frame = frame.sort_values(["k0", "V_over_Vc", "dt"], ascending=[False, True, False]).reset_index(drop=True)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(out, index=False)
-    return frame
+    return write_csv(frame, out)
 
 
 def main() -> None:
@@ -62,10 +60,11 @@ def main() -> None:
     ap.add_argument("--max-iter", type=int, default=400, help="cycles (and accelerated cycles) per point")
     ap.add_argument("--dt", default="0.01,0.005",
                     help="time steps, each with cells h = kappa zbar * dt * 5 (the default pairs)")
-    ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_amplitude.csv"))
+    ap.add_argument("--out", default=str(RESULTS / "micro_cohort_amplitude.csv"))
     args = ap.parse_args()
     out = Path(args.out)
     rows = []
+    warm_up(cycle_cohorts, micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6)
     for k0 in (float(v) for v in args.k0.split(",")):
         model = micro.Model(k0=k0)
         Vc = micro.critical_velocity(model).Vc
@@ -75,7 +74,7 @@ def main() -> None:
             V = frac * Vc
             for dt in (float(v) for v in args.dt.split(",")):
                 h = 5.0 * lam * dt
-                t = time.perf_counter()
+                sw = Stopwatch()
                 res = cycle_cohorts(model, V, dt=dt, h=h, tol=1e-6, start=starts.get(h), max_iter=args.max_iter)
                 if res.applicable:
                     starts[h] = res  # (the next V continues from this cycle's whole state)
@@ -83,7 +82,7 @@ def main() -> None:
                                  sigma_min=res.sigma_min, amplitude=res.sigma_max - res.sigma_min,
                                  period=res.period, unjumped=res.unjumped, error=res.error, cycles=res.iterations,
                                  converged=res.converged, applicable=res.applicable,
-                                 wall_s=time.perf_counter() - t, message=res.message))
+                                 wall_s=sw.seconds, message=res.message))
                 print({k: v for k, v in rows[-1].items() if k != "message"}, flush=True)
                 frame = save(rows, out)
     # the law: local exponents at each resolution (their change with the resolution is

@@ -15,17 +15,17 @@ grading).
 from __future__ import annotations
 
 import argparse
-import time
 from pathlib import Path
 
 import pandas as pd
 
 import micro
+# GRADED_MAX is a module constant of micro.cohort, not in its __all__: the uniform steps are
+# had only by setting it to 1 for the run (and restoring it); no option of Cohort sets it
 from micro import cohort
 
-from _budget import K0, merged
+from _harness import K0, RESULTS, timed, warm_up, write_csv
 
-HERE = Path(__file__).resolve().parent
 QUANTITIES = ("sigma_max", "sigma_min", "sigma_before", "sigma_after")
 
 
@@ -34,10 +34,10 @@ def main() -> None:
     ap.add_argument("--k0", default=",".join(str(k) for k in K0))
     ap.add_argument("--fraction", type=float, default=0.1, help="V / V^c")
     ap.add_argument("--tol", type=float, default=2e-6)
-    ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_graded.csv"))
+    ap.add_argument("--out", default=str(RESULTS / "micro_cohort_graded.csv"))
     args = ap.parse_args()
     out = Path(args.out)
-    cohort.cycle_cohorts(micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6)  # compile
+    warm_up(cohort.cycle_cohorts, micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6)
     graded_max = cohort.GRADED_MAX
     for k0 in (float(v) for v in args.k0.split(",")):
         model = micro.Model(k0=k0)
@@ -46,9 +46,7 @@ def main() -> None:
         for grading, factor in (("graded", graded_max), ("uniform", 1.0)):
             cohort.GRADED_MAX = factor
             try:
-                t = time.perf_counter()
-                res = cohort.cycle_cohorts(model, V, tol=args.tol)
-                wall = time.perf_counter() - t
+                res, wall = timed(cohort.cycle_cohorts, model, V, tol=args.tol)
             finally:
                 cohort.GRADED_MAX = graded_max
             rows[grading] = dict(k0=k0, V_over_Vc=args.fraction, V=V, tol=args.tol, grading=grading,
@@ -61,7 +59,7 @@ def main() -> None:
         print(f"k0 = {k0:g}, {args.fraction:g} V^c: graded - uniform: sigma_max {g['sigma_max_minus_uniform']:+.1e}, "
               f"sigma_min {g['sigma_min_minus_uniform']:+.1e} (errors {g['error']:.1e}, {u['error']:.1e}); "
               f"{g['wall_s']:.1f} s against {u['wall_s']:.1f} s", flush=True)
-        merged(out, pd.DataFrame([g, u]), ["k0", "V_over_Vc", "tol", "grading"]).to_csv(out, index=False)
+        write_csv(pd.DataFrame([g, u]), out, keys=["k0", "V_over_Vc", "tol", "grading"])
 
 
 if __name__ == "__main__":

@@ -34,18 +34,20 @@ h and tol).
 from __future__ import annotations
 
 import argparse
-import time
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 import micro
+# private: Newton's method needs the cohort method's cycle map itself (_product_cycle), the
+# support of its marginal (_support), the state cycle_cohorts returns (res.state: its
+# step, graded-grid reference and last marginal) and a start without the coarse first run
+# (_NO_COARSE); the public API gives only the fixed point
 from micro import cohort as C
 
-from _budget import merged
+from _harness import RESULTS, Stopwatch, warm_up, write_csv
 
-HERE = Path(__file__).resolve().parent
 POINTS = "0.0001:0.95,0.001:0.95,0.01:0.95,0.0001:0.9,0.001:0.9,0.01:0.9"
 #: Newton's map drops the blocks a shock leaves unjumped (they lag by about the shock's
 #: slip, ~1 at k0 = 0.01, so sigma moves by about their fraction): its fixed point is
@@ -66,7 +68,7 @@ def cycle_map(model: micro.Model, V: float, h: float, step: float, ref: float):
 
 def newton(G, x: np.ndarray, fd: float, iterations: int = 8) -> dict:
     """Newton's chord iteration on G(x) = x with the forward-difference Jacobian at ``x``."""
-    t = time.perf_counter()
+    sw = Stopwatch()
     g, out = G(x)
     S = C._support(x, g)
     J = np.empty((S.size, S.size))
@@ -75,7 +77,7 @@ def newton(G, x: np.ndarray, fd: float, iterations: int = 8) -> dict:
         xi[i] += fd
         gi, _ = G(xi)
         J[:, k] = (gi[S] - g[S]) / fd
-    jac_s = time.perf_counter() - t
+    jac_s = sw.seconds
     mult = np.sort(np.abs(np.linalg.eigvals(J)))[::-1]
     A = np.eye(S.size) - J
     history = [(float(np.abs(g - x).sum()), out["sigma_max"], out["sigma_min"])]
@@ -89,7 +91,7 @@ def newton(G, x: np.ndarray, fd: float, iterations: int = 8) -> dict:
         if history[-1][0] < 1e-10:
             break
     h = np.array(history)
-    return dict(nodes=S.size, jac_s=jac_s, newton_s=time.perf_counter() - t - jac_s, iterations=len(h) - 1,
+    return dict(nodes=S.size, jac_s=jac_s, newton_s=sw.seconds - jac_s, iterations=len(h) - 1,
                 residual=h[-1, 0], sigma_max=h[-1, 1], sigma_min=h[-1, 2],
                 last_change=float(np.abs(h[-1, 1:] - h[-2, 1:]).max()), multipliers=mult,
                 unjumped=out["unjumped"], residuals=h[:, 0])
@@ -102,10 +104,10 @@ def main() -> None:
     ap.add_argument("--h", type=float, default=None, help="default kappa zbar / 10; 0: the method's default")
     ap.add_argument("--tol", type=float, default=5e-5)
     ap.add_argument("--fd", type=float, default=1e-6, help="the finite-difference step, in mass")
-    ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_newton_check.csv"))
+    ap.add_argument("--out", default=str(RESULTS / "micro_cohort_newton_check.csv"))
     args = ap.parse_args()
     out = Path(args.out)
-    C.cycle_cohorts(micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6)  # compile
+    warm_up(C.cycle_cohorts, micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6)
     for point in args.points.split(","):
         k0, frac = (float(v) for v in point.split(":"))
         model = micro.Model(k0=k0)
@@ -143,7 +145,7 @@ def main() -> None:
               f"(unjumped {nt['unjumped']:.0e}); multipliers {m[0]:.4f} {m[1]:.4f} {m[2]:.4f}, {row['above_0_9']} above 0.9 of {nt['nodes']}; "
               f"Jacobian {nt['jac_s']:.0f} s; last steps {steps[0]:.1e} {steps[1]:.1e}, slow tails {tail[0]:.1e} "
               f"{tail[1]:.1e} against true {true[0]:.1e} {true[1]:.1e}", flush=True)
-        merged(out, pd.DataFrame([row]), ["k0", "V_over_Vc", "dt", "h", "tol"]).to_csv(out, index=False)
+        write_csv(pd.DataFrame([row]), out, keys=["k0", "V_over_Vc", "dt", "h", "tol"])
 
 
 if __name__ == "__main__":

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import time
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +30,8 @@ import pandas as pd
 import micro
 from micro.cohort import cycle_cohorts
 
-HERE = Path(__file__).resolve().parent
+from _harness import RESULTS, timed, warm_up, write_csv
+
 LEVELS = ((0.02, 0.01), (0.01, 0.005), (0.005, 0.0025))
 
 
@@ -64,8 +64,7 @@ def save(rows: list[dict], out: Path) -> None:
             frame.loc[grp.index, f"{col}_order"] = p
             frame.loc[grp.index, f"{col}_limit"] = lim
             frame.loc[grp.index, f"{col}_distance"] = (grp[col] - lim).abs()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(out, index=False)
+    write_csv(frame, out)
 
 
 def main() -> None:
@@ -73,18 +72,16 @@ def main() -> None:
     ap.add_argument("--k0", default="0.3,0.1,0.01,0.001,0.0001")
     ap.add_argument("--fraction", type=float, default=0.3, help="V / V^c")
     ap.add_argument("--tol", type=float, default=1e-6, help="each level's fixed point to this")
-    ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_refinement.csv"))
+    ap.add_argument("--out", default=str(RESULTS / "micro_cohort_refinement.csv"))
     args = ap.parse_args()
     rows = []
-    cycle_cohorts(micro.Model(k0=0.01), 2.4, dt=0.05, h=0.02, tol=1e-2, max_iter=4)  # compile
+    warm_up(cycle_cohorts, micro.Model(k0=0.01), 2.4, dt=0.05, h=0.02, tol=1e-2, max_iter=4)
     for k0 in (float(v) for v in args.k0.split(",")):
         model = micro.Model(k0=k0)
         V = args.fraction * micro.critical_velocity(model).Vc
         start = None
         for dt, h in LEVELS:
-            t = time.perf_counter()
-            res = cycle_cohorts(model, V, dt=dt, h=h, tol=args.tol, start=start)
-            wall = time.perf_counter() - t
+            res, wall = timed(cycle_cohorts, model, V, dt=dt, h=h, tol=args.tol, start=start)
             start = res
             rows.append(dict(k0=k0, V_over_Vc=args.fraction, V=V, dt=dt, h=h, sigma_max=res.sigma_max,
                              sigma_min=res.sigma_min, sigma_before=res.sigma_before, sigma_after=res.sigma_after,

@@ -16,29 +16,26 @@ from __future__ import annotations
 
 import argparse
 import os
-import time
 from pathlib import Path
 
 import numba
-import numpy as np
 import pandas as pd
 
 import micro
 from micro.cohort import cycle_cohorts
 
-from _budget import K0, merged
+from _harness import K0, RESULTS, Stopwatch, warm_up, write_csv
 
-HERE = Path(__file__).resolve().parent
 FRACTIONS = (0.1, 0.3, 0.5, 0.7, 0.9, 0.95)
 QUANTITIES = ("sigma_max", "sigma_min", "sigma_before", "sigma_after")
 
 
 def run(model: micro.Model, V: float, tol: float) -> dict:
-    t = time.perf_counter()
+    sw = Stopwatch()
     res = cycle_cohorts(model, V, tol=tol)
     row = {name: getattr(res, name) for name in QUANTITIES}
     row.update(error=res.error, cycles=res.iterations, unjumped=res.unjumped, period=res.period,
-               converged=res.converged, wall_s=time.perf_counter() - t, message=res.message)
+               converged=res.converged, wall_s=sw.seconds, message=res.message)
     return row
 
 
@@ -49,13 +46,12 @@ def main() -> None:
     ap.add_argument("--tol", type=float, default=2e-5)
     ap.add_argument("--reference", action="store_true", help="also run each point at --ref-tol")
     ap.add_argument("--ref-tol", type=float, default=1e-7)
-    ap.add_argument("--out", default=str(HERE / "results" / "micro_cohort_speed.csv"))
+    ap.add_argument("--out", default=str(RESULTS / "micro_cohort_speed.csv"))
     args = ap.parse_args()
     out = Path(args.out)
-    t = time.perf_counter()
-    cycle_cohorts(micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6)
-    print(f"compilation (or loading numba's cache) and a first cycle: {time.perf_counter() - t:.1f} s; "
-          f"{numba.get_num_threads()} threads, load average {os.getloadavg()[0]:.2f}", flush=True)
+    warm_up(cycle_cohorts, micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6,
+            label="compilation (or loading numba's cache) and a first cycle")
+    print(f"{numba.get_num_threads()} threads, load average {os.getloadavg()[0]:.2f}", flush=True)
     for k0 in (float(v) for v in args.k0.split(",")):
         model = micro.Model(k0=k0)
         Vc = micro.critical_velocity(model).Vc
@@ -71,8 +67,7 @@ def main() -> None:
                   f"(before/after the shock {row['sigma_before']:.6f} / {row['sigma_after']:.6f}), error "
                   f"{row['error']:.1e}" + (f" (true {row['true_error']:.1e})" if args.reference else "") +
                   f", {row['cycles']} cycles, {row['wall_s']:.1f} s, converged {row['converged']}", flush=True)
-            frame = pd.DataFrame([row])
-            merged(out, frame, ["k0", "V_over_Vc", "tol"]).to_csv(out, index=False)
+            write_csv(pd.DataFrame([row]), out, keys=["k0", "V_over_Vc", "tol"])
 
 
 if __name__ == "__main__":

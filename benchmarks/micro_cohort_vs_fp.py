@@ -17,15 +17,9 @@ Writes benchmarks/results/micro_cohort_vs_fp.csv and micro_cohort_vs_fp.png.
 """
 from __future__ import annotations
 
-from pathlib import Path
+import pandas as pd
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import pandas as pd  # noqa: E402
-
-RESULTS = Path(__file__).resolve().parent / "results"
+from _harness import RESULTS, pyplot, save_figure, write_csv
 
 
 def main() -> None:
@@ -57,10 +51,10 @@ def main() -> None:
             rows.append(dict(point=point, method="shock-to-shock map (FP)" if r.method == "cycle" else "time-stepping (FP)",
                              resolution=r.eps, wall_s=r.wall_s,
                              error=max(abs(r.sigma_max - lim), abs(r.sigma_min - r.sigma_min_exact))))
-    frame = pd.DataFrame(rows)
-    frame.to_csv(RESULTS / "micro_cohort_vs_fp.csv", index=False)
+    frame = write_csv(pd.DataFrame(rows), RESULTS / "micro_cohort_vs_fp.csv")
     print(frame.to_string())
     points = list(dict.fromkeys(frame.point))
+    plt = pyplot()
     fig, axes = plt.subplots(1, len(points), figsize=(4.2 * len(points), 3.8), sharey=True)
     markers = {"cohorts": "o-", "time-stepping (FP)": "s-", "shock-to-shock map (FP)": "^-", "N-block": "d-"}
     for ax, point in zip(axes, points):
@@ -73,7 +67,7 @@ def main() -> None:
     axes[0].set_ylabel("error of sigma_max, sigma_min")
     axes[0].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(RESULTS / "micro_cohort_vs_fp.png", dpi=120)
+    save_figure(fig, RESULTS / "micro_cohort_vs_fp.png")
 
 
 if __name__ == "__main__":

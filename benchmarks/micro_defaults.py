@@ -25,12 +25,12 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import pandas as pd
 
-RESULTS = Path(__file__).resolve().parent / "results"
+from _harness import RESULTS, Stopwatch, timed, warm_up, write_csv
+
 CALLS = (("0.01", "4"), ("0.001", "40,70"), ("0.0001", "400,700"))
 
 
@@ -38,21 +38,21 @@ def _run(k0: str, V: str, cache: str) -> tuple[float, pd.DataFrame]:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "sweep.csv"
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-        start = time.perf_counter()
+        sw = Stopwatch()
         subprocess.run([sys.executable, "-m", "micro", "sweep", "--k0", k0, "--V", V, "--out", str(out)],
                        check=True, env=env, stderr=subprocess.DEVNULL)
-        return time.perf_counter() - start, pd.read_csv(out)
+        return sw.seconds, pd.read_csv(out)
 
 
 def _nblock(N: int) -> dict:
     import micro
     from micro.nblock import stick_slip_extrema_nblock
 
-    start = time.perf_counter()
-    res = stick_slip_extrema_nblock(micro.Model(k0=0.01), 4.0, N, n_cycles=20, n_discard=10, seed=1)
+    warm_up(stick_slip_extrema_nblock, micro.Model(k0=0.01), 4.0, 100, n_cycles=3, n_discard=1)
+    res, wall = timed(stick_slip_extrema_nblock, micro.Model(k0=0.01), 4.0, N, n_cycles=20, n_discard=10, seed=1)
     return {"nblock_N": N, "nblock_sigma_max": res.sigma_max, "nblock_sigma_max_stderr": res.sigma_max_stderr,
             "nblock_sigma_min": res.sigma_min, "nblock_sigma_min_stderr": res.sigma_min_stderr,
-            "nblock_wall_s": time.perf_counter() - start}
+            "nblock_wall_s": wall}
 
 
 def main() -> None:
@@ -84,8 +84,7 @@ def main() -> None:
         print(f"N-block N = {args.nblock}: sigma_max {ref['nblock_sigma_max']:.6f} ± "
               f"{ref['nblock_sigma_max_stderr']:.1e}, sigma_min {ref['nblock_sigma_min']:.6f} ± "
               f"{ref['nblock_sigma_min_stderr']:.1e} ({ref['nblock_wall_s']:.0f} s)", flush=True)
-    RESULTS.mkdir(exist_ok=True)
-    out.to_csv(RESULTS / "micro_defaults.csv", index=False)
+    write_csv(out, RESULTS / "micro_defaults.csv")
     print(out.to_string(index=False))
 
 

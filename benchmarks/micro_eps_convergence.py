@@ -28,22 +28,16 @@ from __future__ import annotations
 
 import argparse
 import math
-import time
-from pathlib import Path
 
-import matplotlib
 import matplotlib.ticker
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from scipy.optimize import curve_fit
 
 import micro
-from _budget import K0, VC_RS, capped_t_max, merged
+from _harness import (FIGURES, K0, RESULTS, VC_RS, Stopwatch, capped_t_max, merged, pyplot, save_figure, warm_up,
+                      write_csv)
 
-HERE = Path(__file__).resolve().parent
 EPS = (0.024, 0.016, 0.012, 0.008, 0.006, 0.004)
 
 
@@ -51,10 +45,10 @@ def run_point(k0: float, V: float, eps: float, budget: float, t_max: float | Non
     model = micro.Model(k0=k0)
     if t_max is None:
         t_max = capped_t_max(model, V, eps, budget)
-    t = time.perf_counter()
+    sw = Stopwatch()
     r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(t_max=t_max), method="fp")
     return dict(k0=k0, V=V, eps=eps, regime=r.regime, converged=r.converged, sigma=r.sigma_mean,
-                sigma_stderr=r.sigma_stderr, t_end=r.t_end, t_max=t_max, wall_s=time.perf_counter() - t,
+                sigma_stderr=r.sigma_stderr, t_end=r.t_end, t_max=t_max, wall_s=sw.seconds,
                 mass_error=r.mass_error, min_mass=r.min_mass, message=r.message)
 
 
@@ -88,7 +82,7 @@ def main() -> None:
     ap.add_argument("--eps", type=str, default=",".join(map(str, EPS)), help="comma-separated bins, coarse to fine")
     ap.add_argument("--replot", action="store_true", help="redo the table and plot from the CSV of a previous run")
     args = ap.parse_args()
-    out = HERE / "results" / "micro_eps_convergence.csv"
+    out = RESULTS / "micro_eps_convergence.csv"
     columns = ["k0", "V", "eps", "regime", "converged", "sigma", "sigma_stderr", "t_end", "t_max", "wall_s",
                "mass_error", "min_mass", "message"]
     if args.replot:
@@ -96,7 +90,7 @@ def main() -> None:
     else:
         k0s = [float(x) for x in args.k0.split(",")]
         bins = [float(x) for x in args.eps.split(",")]
-        micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
+        warm_up(micro.stationary, micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")
         rows = []
         for k0 in k0s:
             V = 1.5 * VC_RS[k0]
@@ -124,13 +118,13 @@ def main() -> None:
                             order=order, extrapolation=extrap, extrapolation_order=p))
     table = table.merge(pd.DataFrame(summary)[["k0", "order", "extrapolation", "extrapolation_order"]], on="k0")
     table["within_1pct_of_weakening"] = np.abs(table.error) <= 0.01 * np.abs(table.weakening)
-    table.to_csv(out, index=False)
+    write_csv(table, out)
     pd.set_option("display.width", 200)
     print(table[["k0", "V", "eps", "converged", "sigma", "sigma_stderr", "error", "weakening",
                  "within_1pct_of_weakening", "wall_s"]].to_string(index=False))
     print(pd.DataFrame(summary).to_string(index=False))
 
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    fig, axes = pyplot().subplots(1, 2, figsize=(10, 4))
     for k0, d in table.groupby("k0", sort=False):
         ok = d[d.converged]
         line, = axes[0].plot(d.eps, d.sigma, "o-", label=f"k0 = {k0:g}, V = {d.V.iloc[0]:.3g}")
@@ -149,7 +143,7 @@ def main() -> None:
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(HERE.parent / "docs" / "figures" / "micro_eps_convergence.png", dpi=120)
+    save_figure(fig, FIGURES / "micro_eps_convergence.png")
 
 
 if __name__ == "__main__":

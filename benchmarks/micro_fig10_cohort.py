@@ -16,47 +16,42 @@ Writes benchmarks/results/micro_fig10_cohort.csv and micro_fig10_cohort.png.
 from __future__ import annotations
 
 import argparse
-import time
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
+import micro
 
-import micro  # noqa: E402
+from _harness import K0, RESULTS, Stopwatch, pyplot, save_figure, warm_up, write_csv
 
-HERE = Path(__file__).resolve().parent
-K0 = (0.3, 0.1, 0.01, 0.001, 0.0001)
 FRACTIONS = (0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 0.95, 1.05, 1.5, 3.0)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--k0", default=",".join(str(k) for k in K0))
-    ap.add_argument("--out", default=str(HERE / "results" / "micro_fig10_cohort.csv"))
+    ap.add_argument("--out", default=str(RESULTS / "micro_fig10_cohort.csv"))
     args = ap.parse_args()
     frames = []
+    warm_up(micro.stationary, micro.Model(k0=0.1), 0.3, method=micro.Cohort(tol=1e-3, max_iter=6))
     for k0 in (float(v) for v in args.k0.split(",")):
         model = micro.Model(k0=k0)
         Vc = micro.critical_velocity(model).Vc
-        t = time.perf_counter()
+        sw = Stopwatch()
         # (the fixed point to 1e-5 in stress, what Convergence(rtol=1e-4) meant for the cohort
         # method before it had options of its own)
         frame = micro.sweep(model, [f * Vc for f in FRACTIONS], method=micro.Cohort(tol=1e-5))
         frame.insert(0, "Vc", Vc)
         frame.insert(1, "V_over_Vc", list(FRACTIONS))
-        print(f"k0 = {k0:g}: {len(frame)} rows in {time.perf_counter() - t:.1f} s; slowest row "
+        print(f"k0 = {k0:g}: {len(frame)} rows in {sw.seconds:.1f} s; slowest row "
               f"{frame.wall_time.max():.1f} s; all converged: {bool(frame.converged.all())}", flush=True)
         frames.append(frame)
-    frame = pd.concat(frames, ignore_index=True)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(args.out, index=False)
+    frame = write_csv(pd.concat(frames, ignore_index=True), args.out)
     with pd.option_context("display.width", 200, "display.max_columns", 12):
         print(frame[["k0", "V_over_Vc", "regime", "sigma_max", "sigma_min", "sigma_stderr", "converged",
                      "wall_time"]])
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     for (k0, grp), color in zip(frame.groupby("k0", sort=False), plt.cm.viridis(np.linspace(0, 0.9, len(frames)))):
         ss = grp[grp.regime == "stick-slip"]
@@ -69,7 +64,7 @@ def main() -> None:
     ax.set_ylabel("stress: steady (lines), stick-slip max and min (triangles)")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(Path(args.out).with_suffix(".png"), dpi=120)
+    save_figure(fig, Path(args.out).with_suffix(".png"))
 
 
 if __name__ == "__main__":

@@ -12,38 +12,30 @@ benchmarks/results/micro_fp_error_vs_time.csv and docs/figures/micro_fp_error_vs
 """
 from __future__ import annotations
 
-import time
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
 import micro
+from _harness import FIGURES, RESULTS, pyplot, save_figure, timed, warm_up, write_csv
 
-HERE = Path(__file__).resolve().parent
 MODEL = micro.Model(k0=0.1)
 EPS = (0.016, 0.012, 0.008, 0.005)  # 0.024 misses the rtol 1e-3 cycle test
 
 
 def main() -> None:
-    nb = pd.read_csv(HERE / "results" / "micro_nblock_convergence.csv")
+    nb = pd.read_csv(RESULTS / "micro_nblock_convergence.csv")
     ref_steady = nb[nb.point == "steady"].sort_values("N").iloc[-1]
     ref_cycle = nb[nb.point == "stick-slip"].sort_values("N").iloc[-1]
-    micro.stationary(MODEL, 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile / warm up
+    warm_up(micro.stationary, MODEL, 2.0, numerics=micro.Numerics(eps=0.024), method="fp")
     rows = []
     for eps in EPS:
-        t = time.perf_counter()
-        r = micro.stationary(MODEL, 2.0, numerics=micro.Numerics(eps=eps), method="fp")
-        rows.append(dict(solver="FP", point="steady", eps=eps, wall_s=time.perf_counter() - t, converged=r.converged,
+        r, wall = timed(micro.stationary, MODEL, 2.0, numerics=micro.Numerics(eps=eps), method="fp")
+        rows.append(dict(solver="FP", point="steady", eps=eps, wall_s=wall, converged=r.converged,
                          value=r.sigma_mean, error_vs_nblock=r.sigma_mean - ref_steady.sigma_mean))
-        t = time.perf_counter()
-        r = micro.stationary(MODEL, 0.05, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(rtol=1e-3), method="fp")
+        r, wall = timed(micro.stationary, MODEL, 0.05, numerics=micro.Numerics(eps=eps),
+                        convergence=micro.Convergence(rtol=1e-3), method="fp")
         err = max(abs(r.sigma_max - ref_cycle.sigma_max), abs(r.sigma_min - ref_cycle.sigma_min))
-        rows.append(dict(solver="FP", point="stick-slip", eps=eps, wall_s=time.perf_counter() - t, converged=r.converged,
+        rows.append(dict(solver="FP", point="stick-slip", eps=eps, wall_s=wall, converged=r.converged,
                          value=r.sigma_max, value_min=r.sigma_min, error_vs_nblock=err))
         print(rows[-2], rows[-1], flush=True)
     fp = pd.DataFrame(rows)
@@ -63,13 +55,11 @@ def main() -> None:
         else:
             err = max(abs(row.sigma_max - ref.sigma_max), abs(row.sigma_min - ref.sigma_min))
         rows.append(dict(solver="N-block", point=row.point, N=row.N, wall_s=row.wall_s, error_vs_nblock=err))
-    table = pd.DataFrame(rows)
-    out = HERE / "results" / "micro_fp_error_vs_time.csv"
-    table.to_csv(out, index=False)
+    table = write_csv(rows, RESULTS / "micro_fp_error_vs_time.csv")
     print(table.to_string(index=False))
     print(f"steady eps->0 extrapolation {extrap:.7f}; N-block N={int(ref_steady.N)}: "
           f"{ref_steady.sigma_mean:.7f} +- {ref_steady.sigma_stderr:.1e}")
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
+    fig, axes = pyplot().subplots(1, 2, figsize=(9, 3.6), sharey=True)
     for ax, point in zip(axes, ("steady", "stick-slip")):
         for solver, marker in (("FP", "o-"), ("N-block", "s--")):
             d = table[(table.point == point) & (table.solver == solver)]
@@ -80,7 +70,7 @@ def main() -> None:
     axes[0].set_ylabel("|error| against N-block N = 1e6")
     axes[0].legend()
     fig.tight_layout()
-    fig.savefig(HERE.parent / "docs" / "figures" / "micro_fp_error_vs_time.png", dpi=120)
+    save_figure(fig, FIGURES / "micro_fp_error_vs_time.png")
 
 
 if __name__ == "__main__":

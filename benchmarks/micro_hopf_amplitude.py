@@ -21,17 +21,14 @@ has its windows lengthened by the same factor.
 from __future__ import annotations
 
 import argparse
-import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 import micro
-from _budget import merged
+from _harness import RESULTS, Stopwatch, write_csv
 from micro.nblock import simulate_nblock
 
-HERE = Path(__file__).resolve().parent
 
 
 def amplitude(t: np.ndarray, smax: np.ndarray, smin: np.ndarray, window: float, t_max: float) -> tuple[float, float]:
@@ -53,30 +50,32 @@ def run_length(model: micro.Model, V: float, t_max: float, window: float) -> tup
 
 def fp_rows(model: micro.Model, eps: float, Vs: list[float], t_max: float, window: float, V_start: float) -> list[dict]:
     num = micro.Numerics(eps=eps)
+    # (the steady start compiles the kernels, or loads numba's cache, before any clock starts)
     base = micro.stationary(model, V_start, numerics=num, keep_grid=True, method="fp")
     rows = []
     for V in Vs:
-        t = time.perf_counter()
+        sw = Stopwatch()
         T, W = run_length(model, V, t_max, window)
         r = micro.simulate(model, V, duration=T, numerics=num, initial=base.grid,
                            record_dsigma=0.25 * model.k0 * eps, record_dt=W / 200.0).records
         med, top = amplitude(r.t.to_numpy(), r.sigma_max.to_numpy(), r.sigma_min.to_numpy(), W, T)
         rows.append(dict(solver="fp", resolution=eps, V=V, amplitude=med, amplitude_max=top,
-                         in_k0_eps=med / (model.k0 * eps), t_max=T, wall_s=time.perf_counter() - t))
+                         in_k0_eps=med / (model.k0 * eps), t_max=T, wall_s=sw.seconds))
         print(rows[-1], flush=True)
     return rows
 
 
 def nblock_rows(model: micro.Model, N: int, Vs: list[float], t_max: float, window: float, V_start: float) -> list[dict]:
+    # (the steady start compiles the kernels, or loads numba's cache, before any clock starts)
     base = simulate_nblock(model, V_start, N, t_max=30.0, initial="frozen")
     rows = []
     for V in Vs:
-        t = time.perf_counter()
+        sw = Stopwatch()
         T, W = run_length(model, V, t_max, window)
         r = simulate_nblock(model, V, N, t_max=T, initial=base.final_state, record_every=W / 500.0).timeseries
         med, top = amplitude(r.t.to_numpy(), r.sigma_max.to_numpy(), r.sigma_min.to_numpy(), W, T)
         rows.append(dict(solver="nblock", resolution=float(N), V=V, amplitude=med, amplitude_max=top,
-                         in_k0_eps=np.nan, t_max=T, wall_s=time.perf_counter() - t))
+                         in_k0_eps=np.nan, t_max=T, wall_s=sw.seconds))
         print(rows[-1], flush=True)
     return rows
 
@@ -98,7 +97,7 @@ def main() -> None:
     model = micro.Model(k0=args.k0, k1=args.k1, k2=args.k2)
     Vs = [float(v) for v in args.V.split(",")]
     V_start = args.V_start if args.V_start is not None else max(2.0, 1.5 * max(Vs))
-    out = HERE / "results" / "micro_hopf_amplitude.csv"
+    out = RESULTS / "micro_hopf_amplitude.csv"
     runs = []
     if args.solver in ("fp", "both"):
         runs += [("fp", float(e)) for e in args.eps.split(",")]
@@ -110,7 +109,7 @@ def main() -> None:
         else:
             rows = nblock_rows(model, int(res), Vs, args.t_max, args.window, V_start)
         new = pd.DataFrame(rows).assign(k0=args.k0, k1=args.k1, k2=args.k2)
-        merged(out, new, ["k0", "k1", "k2", "resolution", "V"]).to_csv(out, index=False)
+        write_csv(new, out, keys=["k0", "k1", "k2", "resolution", "V"])
     table = pd.read_csv(out).sort_values(["k1", "k0", "V", "solver", "resolution"])
     print(table.pivot_table(index=["k1", "k2", "k0", "V"], columns=["solver", "resolution"], values="amplitude").to_string(
         float_format=lambda x: f"{x:.4f}"))

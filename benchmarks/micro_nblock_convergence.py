@@ -25,7 +25,6 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -34,17 +33,20 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from micro import Exponential, Model  # noqa: E402
 from micro import nblock as nb  # noqa: E402
-from micro.params import Exponential, Model  # noqa: E402
+
+from _harness import RESULTS, timed, warm_up, write_csv  # noqa: E402
 
 logger = logging.getLogger("micro_nblock_convergence")
 
 STEADY = dict(k0=0.1, velocity=2.0, t_transient=10.0, batch_length=2.0, n_batches=10)
 STICK_SLIP = dict(k0=0.1, velocity=0.05, n_discard=10, n_cycles=20)
 
+# (the tiny run times itself from before its imports, in a fresh interpreter)
 TINY = (
     "import time; t = time.perf_counter();"
-    "from micro import nblock as nb; from micro.params import Model;"
+    "from micro import Model, nblock as nb;"
     "nb.simulate_nblock(Model(k0=0.3), 1.0, 50, t_max=1.0);"
     "print(time.perf_counter() - t)"
 )
@@ -66,12 +68,10 @@ def model(k0: float) -> Model:
 def steady_row(n: int) -> dict:
     p = STEADY
     m = model(p["k0"])
-    start = time.perf_counter()
-    out = nb.stationary_stress_nblock(
-        m, p["velocity"], n, t_transient=p["t_transient"], batch_length=p["batch_length"],
-        n_batches=p["n_batches"], initial="frozen",
+    out, wall = timed(
+        nb.stationary_stress_nblock, m, p["velocity"], n, t_transient=p["t_transient"],
+        batch_length=p["batch_length"], n_batches=p["n_batches"], initial="frozen",
     )
-    wall = time.perf_counter() - start
     res = out.result
     ts = res.timeseries.iloc[-p["n_batches"]:]
     return dict(
@@ -92,9 +92,8 @@ def steady_row(n: int) -> dict:
 def stick_slip_row(n: int) -> dict:
     p = STICK_SLIP
     m = model(p["k0"])
-    start = time.perf_counter()
-    out = nb.stick_slip_extrema_nblock(m, p["velocity"], n, n_cycles=p["n_cycles"], n_discard=p["n_discard"])
-    wall = time.perf_counter() - start
+    out, wall = timed(nb.stick_slip_extrema_nblock, m, p["velocity"], n, n_cycles=p["n_cycles"],
+                      n_discard=p["n_discard"])
     res = out.result
     return dict(
         point="stick-slip", k0=p["k0"], V=p["velocity"], N=n, wall_s=wall, n_jumps=res.n_jumps,
@@ -114,19 +113,18 @@ def stick_slip_row(n: int) -> dict:
 def main(argv: list[str] | None = None) -> pd.DataFrame:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-n", type=int, default=1_000_000, help="largest N (powers of ten from 1e3)")
-    parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results", help="directory of the CSV files")
+    parser.add_argument("--out", type=Path, default=RESULTS, help="directory of the CSV files")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
-    args.out.mkdir(parents=True, exist_ok=True)
 
     with tempfile.TemporaryDirectory() as empty:
         cold = first_call_seconds(empty)
     warm = first_call_seconds(None)
     # compile (or load) the kernels in this process before any clock starts
-    nb.simulate_nblock(model(0.3), 1.0, 50, t_max=1.0)
-    compile_table = pd.DataFrame([dict(what="first tiny run, empty numba cache (JIT compile)", seconds=cold),
-                                  dict(what="first tiny run, numba cache present (cache load)", seconds=warm)])
-    compile_table.to_csv(args.out / "micro_nblock_compile.csv", index=False)
+    warm_up(nb.simulate_nblock, model(0.3), 1.0, 50, t_max=1.0)
+    compile_table = write_csv([dict(what="first tiny run, empty numba cache (JIT compile)", seconds=cold),
+                               dict(what="first tiny run, numba cache present (cache load)", seconds=warm)],
+                              args.out / "micro_nblock_compile.csv")
     print(compile_table.to_string(index=False))
 
     sizes = [n for n in (1_000, 10_000, 100_000, 1_000_000) if n <= args.max_n]
@@ -136,7 +134,7 @@ def main(argv: list[str] | None = None) -> pd.DataFrame:
             row = make(n)
             logger.info("%s N=%d done in %.1f s", row["point"], n, row["wall_s"])
             rows.append(row)
-            pd.DataFrame(rows).to_csv(args.out / "micro_nblock_convergence.csv", index=False)
+            write_csv(rows, args.out / "micro_nblock_convergence.csv")
     table = pd.DataFrame(rows)
     with pd.option_context("display.width", 200, "display.max_columns", 30):
         print("\nsteady point (k0 = 0.1, V = 2): stationary stress")

@@ -15,13 +15,18 @@ with correlation-aware standard errors and whether they drift.
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 
 import micro
 from micro.cohort import cycle_cohorts
-from micro.nblock import NBlockState, _correlated_stderr, _drifts, simulate_nblock
+from micro.nblock import NBlockState, simulate_nblock
+# private: the N-block's own estimators of a correlated series (the standard error that
+# stick_slip_extrema_nblock reports, and its drift test), applied here to shocks that
+# simulate_nblock records; the public API applies them only inside its own cycle runs
+from micro.nblock import _correlated_stderr, _drifts
+
+from _harness import Stopwatch, warm_up
 
 
 def start_state(model: micro.Model, p: tuple[np.ndarray, np.ndarray], n: int, seed: int) -> NBlockState:
@@ -51,19 +56,21 @@ def main() -> None:
     args = ap.parse_args()
     model = micro.Model(k0=args.k0)
     V = args.fraction * micro.critical_velocity(model).Vc
-    t = time.perf_counter()
+    warm_up(cycle_cohorts, micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6)
+    warm_up(simulate_nblock, model, V, 50, t_max=1.0, label="the N-block's compilation (or numba's cache)")
+    sw = Stopwatch()
     res = cycle_cohorts(model, V, tol=1e-6)
     if res.p is None:
         raise SystemExit("the cohorts' shocks are not total here: no product state to start from")
     print(f"cohorts: sigma_max {res.sigma_max:.6f}, sigma_min {res.sigma_min:.6f}, period {res.period:.4f} "
-          f"(error {res.error:.1e}, {time.perf_counter() - t:.0f} s)", flush=True)
-    t = time.perf_counter()
+          f"(error {res.error:.1e}, {sw.seconds:.0f} s)", flush=True)
+    sw.restart()
     run = simulate_nblock(model, V, args.N, t_max=3.0 * args.shocks * res.period, seed=args.seed,
                           initial=start_state(model, res.p, args.N, args.seed), stop_after_shocks=args.shocks,
                           record_every=res.period / 50)
     sb, sa = run.shocks.sigma_before.to_numpy(), run.shocks.sigma_after.to_numpy()
     period = np.diff(np.r_[0.0, run.shocks.t.to_numpy()])
-    print(f"N-block, N = {args.N}, seed {args.seed}: {sb.size} shocks in {time.perf_counter() - t:.0f} s")
+    print(f"N-block, N = {args.N}, seed {args.seed}: {sb.size} shocks in {sw.seconds:.0f} s")
     print(f"  sigma_max {sb.mean():.6f} +- {_correlated_stderr(sb):.1e} (drifts: {_drifts(sb)}), "
           f"sigma_min {sa.mean():.6f} +- {_correlated_stderr(sa):.1e}, "
           f"period {period.mean():.4f} +- {_correlated_stderr(period):.1e}")

@@ -29,23 +29,16 @@ from __future__ import annotations
 
 import argparse
 import math
-import time
-from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from scipy.optimize import curve_fit
 
 import micro
-from _budget import K0, VC_RS, capped_t_max, merged
+from _harness import (DATA, FIGURES, K0, VC_RS, Stopwatch, capped_t_max, merged, pyplot, save_figure, timed,
+                      warm_up, write_csv)
 
-ROOT = Path(__file__).resolve().parent.parent
-DATA = ROOT / "docs" / "data"
-FIGS = ROOT / "docs" / "figures"
+plt = pyplot()
 RATIOS = (0.03, 0.1, 0.3, 0.6, 0.85, 1.2, 2.0, 5.0)
 
 
@@ -55,7 +48,7 @@ def _finish(fig, ax, xlabel: str, ylabel: str, title: str, name: str) -> None:
     ax.set_title(title)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(FIGS / f"{name}.png", dpi=120)
+    save_figure(fig, FIGURES / f"{name}.png")
 
 
 def fig3(eps: float, budget: float) -> None:
@@ -71,7 +64,7 @@ def fig3(eps: float, budget: float) -> None:
         frames.append(rec)
         print(f"fig 3: V = {V}: {duration:.4g} time units in {run.wall_time:.1f} s", flush=True)
     data = pd.concat(frames)
-    data.to_csv(DATA / "micro_fig3.csv", index=False)
+    write_csv(data, DATA / "micro_fig3.csv")
     fig, ax = plt.subplots(figsize=(6, 3.6))
     for V, d in data.groupby("V"):
         ax.plot(d.t * V, d.sigma, lw=0.8, label=f"V = {V:g}")
@@ -89,7 +82,7 @@ def fig4(eps: float, budget: float, k0s, ratios=RATIOS, t_max: float | None = No
         model = micro.Model(k0=k0)
         for r in ratios:
             V = r * VC_RS[k0]
-            t = time.perf_counter()
+            sw = Stopwatch()
             try:
                 cap = t_max if t_max is not None else capped_t_max(model, V, eps, budget)
                 res = micro.stationary(model, V, numerics=micro.Numerics(eps=eps),
@@ -98,13 +91,13 @@ def fig4(eps: float, budget: float, k0s, ratios=RATIOS, t_max: float | None = No
             except micro.GridTooLarge as exc:  # the solver's clear refusal: kept, drawn nowhere
                 row = dict(k0=k0, V=V, regime="refused", converged=False, sigma_max=math.nan,
                            sigma_min=math.nan, sigma_mean=math.nan, message=str(exc))
-            row["wall_time"] = time.perf_counter() - t
+            row["wall_time"] = sw.seconds
             rows.append(row)
             print(f"fig 4: k0 = {k0:g}, V = {V:.4g}: {row['regime']} converged={row['converged']} "
                   f"{row['sigma_max']:.5f}/{row['sigma_min']:.5f} in {row['wall_time']:.1f} s", flush=True)
             # keep what is done, replacing the same points of a previous run
             data = merged(out, pd.DataFrame(rows), ["k0", "V"])
-            data.sort_values(["k0", "V"], ascending=[False, True]).to_csv(out, index=False)
+            write_csv(data.sort_values(["k0", "V"], ascending=[False, True]), out)
     data = pd.read_csv(out)
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for k0, d in data.groupby("k0", sort=False):
@@ -138,9 +131,7 @@ def fig6(data: pd.DataFrame) -> None:
 def fig7(eps: float) -> None:
     model = micro.Model(k0=0.1)
     holds = np.concatenate([[0.0], np.logspace(-2, 1.3, 12)])
-    t = time.perf_counter()
-    data = micro.slide_hold_slide(model, 1000.0, holds, numerics=micro.Numerics(eps=eps))
-    wall = time.perf_counter() - t
+    data, wall = timed(micro.slide_hold_slide, model, 1000.0, holds, numerics=micro.Numerics(eps=eps))
     fit = data[data.hold_time > 0]
 
     def law(dt, d_inf, tau):
@@ -149,7 +140,7 @@ def fig7(eps: float) -> None:
     (d_inf, tau), cov = curve_fit(law, fit.hold_time, fit.delta_sigma_max, p0=(fit.delta_sigma_max.max(), 1.0))
     err = np.sqrt(np.diag(cov))
     data["fit"] = law(data.hold_time, d_inf, tau)
-    data.to_csv(DATA / "micro_fig7.csv", index=False)
+    write_csv(data, DATA / "micro_fig7.csv")
     print(f"fig 7: d_inf = {d_inf:.5f} +- {err[0]:.1g}, tau = {tau:.4f} +- {err[1]:.1g} "
           f"(relaxation time eta_u / k2 = {model.eta_u / model.k2:.4f}); {wall:.1f} s", flush=True)
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -172,9 +163,7 @@ def main() -> None:
     ap.add_argument("--replot", action="store_true", help="Figs. 4, 6: redraw from docs/data/micro_fig4.csv")
     args = ap.parse_args()
     figs = {int(f) for f in args.figs.split(",")}
-    DATA.mkdir(parents=True, exist_ok=True)
-    FIGS.mkdir(parents=True, exist_ok=True)
-    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
+    warm_up(micro.stationary, micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")
     if 3 in figs:
         fig3(args.eps, 10 * args.budget)
     if 4 in figs or 6 in figs:

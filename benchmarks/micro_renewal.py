@@ -25,27 +25,19 @@ benchmarks/results/micro_renewal_{grid,default,vc,stress,fp}.csv.
 """
 from __future__ import annotations
 
-import time
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
 
 import micro
+# private: the grid table solves the chain on a fixed grid of n nodes (_Grid, _Chain, with
+# the quadrature _quadrature and the map's width _map_width), which steady_sliding chooses
+# itself; critical_velocity_renewal (micro.renewal's __all__) takes a tolerance that
+# critical_velocity does not pass on
 from micro import renewal as R
 
-RESULTS = Path(__file__).parent / "results"
-PAPER_K0 = (0.3, 0.1, 0.01, 1e-3, 1e-4)
+from _harness import K0, RESULTS, median_time, timed, warm_up, write_csv
+
 SETS = ((0.1, 0.9), (0.0, 1.0), (0.5, 0.5), (0.9, 0.1))
-
-
-def median_time(fn, repeats: int = 7) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
 
 
 def grid_table() -> pd.DataFrame:
@@ -69,7 +61,7 @@ def grid_table() -> pd.DataFrame:
 
 def default_table() -> pd.DataFrame:
     rows = []
-    for k0 in PAPER_K0:
+    for k0 in K0:
         model = micro.Model(k0=k0)
         Vc = micro.critical_velocity(model).Vc
         for V in (0.5 * Vc, 1.5 * Vc, 10 * Vc, 1e4):
@@ -86,11 +78,9 @@ def default_table() -> pd.DataFrame:
 def vc_table() -> pd.DataFrame:
     rows = []
     for k1, k2 in SETS:
-        for k0 in PAPER_K0:
+        for k0 in K0:
             model = micro.Model(k0=k0, k1=k1, k2=k2)
-            t0 = time.perf_counter()
-            crit = micro.critical_velocity(model)
-            wall = time.perf_counter() - t0
+            crit, wall = timed(micro.critical_velocity, model)
             tight, _, _, _, _ = R.critical_velocity_renewal(model, V_max=1e7, tol=1e-13)
             rows.append(dict(k1=k1, k2=k2, k0=k0, Vc=crit.Vc, status=crit.status, wall_s=wall,
                              error_estimate=(crit.V_high - crit.Vc) if crit.Vc > 0 else 0.0,
@@ -108,9 +98,7 @@ def stress_table() -> pd.DataFrame:
         for k1, k2 in SETS:
             for k0 in (1e-4, 1e-3, 1e-2, 0.1, 0.5, 1.0):
                 model = micro.Model(k0=k0, k1=k1, k2=k2, jumps=jumps)
-                t0 = time.perf_counter()
-                res = micro.steady_sliding(model, V, growth_rate=False, warn=False)
-                wall = time.perf_counter() - t0
+                res, wall = timed(micro.steady_sliding, model, V, growth_rate=False, warn=False)
                 rows.append(dict(jumps=name, k1=k1, k2=k2, k0=k0, n_V=V.size, wall_s=wall,
                                  finite=bool(np.all(np.isfinite(res.sigma)) and np.all(np.isfinite(res.branching_ratio))),
                                  sigma_decreasing=bool(np.all(np.diff(res.sigma) < 1e-12)),
@@ -133,6 +121,7 @@ def waiting_time_accuracy() -> float | None:
         import mpmath
     except ImportError:
         return None
+    # private: the Newton waiting time is a kernel of the chain, not called on its own publicly
     from micro import _renewal_kernels as RK
     mpmath.mp.dps = 40
     rng = np.random.default_rng(0)
@@ -162,20 +151,17 @@ def fp_table() -> tuple[pd.DataFrame, pd.DataFrame]:
 
 
 def main() -> None:
-    t0 = time.perf_counter()
-    micro.steady_sliding(micro.Model(k0=0.1), 2.0)
-    print(f"compile (first call, numba cache cold or warm): {time.perf_counter() - t0:.2f} s")
-    RESULTS.mkdir(exist_ok=True)
+    warm_up(micro.steady_sliding, micro.Model(k0=0.1), 2.0, label="compile (first call, numba cache cold or warm)")
     for name, frame in (("grid", grid_table()), ("default", default_table()), ("vc", vc_table()),
                         ("stress", stress_table())):
-        frame.to_csv(RESULTS / f"micro_renewal_{name}.csv", index=False)
+        write_csv(frame, RESULTS / f"micro_renewal_{name}.csv")
         print(f"\n## {name}\n" + frame.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
     print(f"\ngrowth rate: {1e3 * growth_rate_time():.0f} ms per unstable V (k0 = 0.1, V = 0.3, 0.6, 0.72)")
     worst = waiting_time_accuracy()
     print("waiting time against a 40-digit root, 3000 random (alpha, D, zeta): " +
           ("skipped (pip install mpmath)" if worst is None else f"worst relative error {worst:.1e}"))
     fp, orders = fp_table()
-    fp.to_csv(RESULTS / "micro_renewal_fp.csv", index=False)
+    write_csv(fp, RESULTS / "micro_renewal_fp.csv")
     print("\n## fp\n" + fp.to_string(index=False, float_format=lambda x: f"{x:.6g}"))
     print("\n## fp order in eps\n" + orders.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
 

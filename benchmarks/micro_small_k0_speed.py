@@ -17,8 +17,6 @@ Writes benchmarks/results/micro_small_k0_speed.csv.
 from __future__ import annotations
 
 import argparse
-import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -26,7 +24,8 @@ import pandas as pd
 import micro
 from micro import nblock
 
-HERE = Path(__file__).resolve().parent
+from _harness import RESULTS, timed, warm_up, write_csv
+
 K0, V = 0.001, 174.75
 
 
@@ -36,20 +35,20 @@ def main() -> None:
     args = ap.parse_args()
     model = micro.Model(k0=K0)
     ref = micro.sigma_fast_limit(model, V)
-    nblock.stationary_stress_nblock(model, V, 100, t_transient=0.5, batch_length=0.5, n_batches=2)  # compile
+    warm_up(nblock.stationary_stress_nblock, model, V, 100, t_transient=0.5, batch_length=0.5, n_batches=2)
     rows = []
     for n in (int(x) for x in args.N.split(",")):
-        t = time.perf_counter()
         # 3 time units of transient (the FP state settles in ~2), 5 batches of 2
-        r = nblock.stationary_stress_nblock(model, V, n, t_transient=3.0, batch_length=2.0, n_batches=5, seed=1)
+        r, wall = timed(nblock.stationary_stress_nblock, model, V, n, t_transient=3.0, batch_length=2.0,
+                        n_batches=5, seed=1)
         rows.append(dict(solver="N-block", N=n, value=r.sigma_mean, stderr=r.sigma_stderr, regime=r.regime,
-                         error=r.sigma_mean - ref, wall_s=time.perf_counter() - t))
+                         error=r.sigma_mean - ref, wall_s=wall))
         print(rows[-1], flush=True)
     nb = pd.DataFrame(rows)
     a_err, c_err = np.polyfit(np.log(nb.N), np.log(np.abs(nb.error)), 1)
     a_t, c_t = np.polyfit(np.log(nb.N), np.log(nb.wall_s), 1)
     print(f"N-block: |error| ~ N^{a_err:.2f}, wall ~ N^{a_t:.2f}")
-    fp = pd.read_csv(HERE / "results" / "micro_eps_convergence.csv")
+    fp = pd.read_csv(RESULTS / "micro_eps_convergence.csv")
     fp = fp[(fp.k0 == K0) & fp.converged.astype(bool)].sort_values("eps", ascending=False)
     for _, row in fp.iterrows():
         err = abs(row.sigma - ref)
@@ -59,8 +58,7 @@ def main() -> None:
                          nblock_N_needed=n_need, nblock_wall_s_extrapolated=t_need, speedup=t_need / row.wall_s))
         print(f"FP eps = {row.eps:g}: error {row.sigma - ref:+.2e} in {row.wall_s:.0f} s; the N-block would need "
               f"N ~ {n_need:.2g} and ~{t_need:.2g} s (extrapolated): {t_need / row.wall_s:.2g}x", flush=True)
-    table = pd.DataFrame(rows)
-    table.to_csv(HERE / "results" / "micro_small_k0_speed.csv", index=False)
+    table = write_csv(rows, RESULTS / "micro_small_k0_speed.csv")
     print(table.to_string(index=False))
 
 

@@ -29,18 +29,15 @@ resolution, so a run with `--N 1e6` alone adds that row).
 from __future__ import annotations
 
 import argparse
-import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 import micro
-from _budget import merged
+from _harness import RESULTS, merged, timed, warm_up, write_csv
 from micro import nblock
 from micro.analysis import Records, find_cycles
 
-HERE = Path(__file__).resolve().parent
 K0, V = 0.01, 1.0
 #: both solvers: cycles discarded as transient, cycles averaged.  The Fokker-Planck
 #: solver's cycle maximum relaxes over 20-30 cycles here (eps = 0.012: means over cycles
@@ -90,19 +87,19 @@ def fp_stationary(model: micro.Model, eps: float, n: int = 3) -> dict:
 
 
 def fp_rows(model: micro.Model, eps_list: list[float]) -> list[dict]:
-    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
+    warm_up(micro.stationary, micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")
     rows = []
     for eps in eps_list:
         for solver, measure in (("fp", fp_cycles), ("fp_stationary", fp_stationary),
                                 ("fp_stationary_n6", lambda m, e: fp_stationary(m, e, n=6))):
-            t = time.perf_counter()
-            rows.append(dict(solver=solver, resolution=eps, **measure(model, eps), wall_s=time.perf_counter() - t))
+            found, wall = timed(measure, model, eps)
+            rows.append(dict(solver=solver, resolution=eps, **found, wall_s=wall))
             print(rows[-1], flush=True)
     return rows
 
 
 def nblock_rows(model: micro.Model, N_list: list[int]) -> list[dict]:
-    nblock.stick_slip_extrema_nblock(model, V, 100, n_cycles=3, n_discard=1)  # compile
+    warm_up(nblock.stick_slip_extrema_nblock, model, V, 100, n_cycles=3, n_discard=1)
     rows = []
     for N in N_list:
         r = nblock.stick_slip_extrema_nblock(model, V, N, n_cycles=N_CYCLES, n_discard=N_DISCARD, seed=0)
@@ -166,11 +163,11 @@ def main() -> None:
         rows += fp_rows(model, [float(e) for e in args.eps.split(",")])
     if args.solver in ("nblock", "both"):
         rows += nblock_rows(model, [int(float(n)) for n in args.N.split(",")])
-    out = HERE / "results" / "micro_stickslip_speed.csv"
+    out = RESULTS / "micro_stickslip_speed.csv"
     keep = ["solver", "resolution", "regime", "converged", "sigma_max", "sigma_min", "period", "sigma_max_stderr",
             "sigma_min_stderr", "sigma_max_drift", "wall_s"]
     table = errors(merged(out, pd.DataFrame(rows), ["solver", "resolution"])[keep].reset_index(drop=True))
-    table.to_csv(out, index=False)
+    write_csv(table, out)
     print(table.to_string(index=False, float_format=lambda x: f"{x:.6g}"))
 
 

@@ -20,15 +20,11 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
-from pathlib import Path
-
-import pandas as pd
 
 import micro
-from _budget import capped_t_max
+from _harness import RESULTS, Stopwatch, capped_t_max, warm_up, write_csv
 
-HERE = Path(__file__).resolve().parent
+OUT = RESULTS / "micro_stress.csv"
 K0 = (1e-4, 1e-3, 1e-2, 0.1, 1.0)
 V = (1e-4, 1e-2, 1.0, 1e2, 1e3)
 #: largest simulated time of a run (the calibration underestimates the cost of slow
@@ -37,15 +33,15 @@ T_CAP = 5e3
 
 
 def check(model: micro.Model, V: float, eps: float, budget: float, t_max: float | None = None) -> dict:
-    t = time.perf_counter()
+    sw = Stopwatch()
     try:
         t_max = min(capped_t_max(model, V, eps, budget), T_CAP) if t_max is None else t_max
         r = micro.stationary(model, V, numerics=micro.Numerics(eps=eps), convergence=micro.Convergence(t_max=t_max), method="fp")
     except micro.GridTooLarge as exc:  # a clear refusal, not a failure
-        return dict(k0=model.k0, V=V, eps=eps, t_max=t_max, wall_s=time.perf_counter() - t, regime="refused",
+        return dict(k0=model.k0, V=V, eps=eps, t_max=t_max, wall_s=sw.seconds, regime="refused",
                     converged=False, sigma_max=math.nan, sigma_min=math.nan, sigma_mean=math.nan,
                     message=str(exc), problems="", t_end=math.nan, mass_error=math.nan, min_mass=math.nan)
-    row = dict(k0=model.k0, V=V, eps=eps, t_max=t_max, t_end=r.t_end, wall_s=time.perf_counter() - t,
+    row = dict(k0=model.k0, V=V, eps=eps, t_max=t_max, t_end=r.t_end, wall_s=sw.seconds,
                regime=r.regime, converged=r.converged, sigma_max=r.sigma_max, sigma_min=r.sigma_min,
                sigma_mean=r.sigma_mean, mass_error=r.mass_error, min_mass=r.min_mass, message=r.message)
     problems = []
@@ -68,12 +64,12 @@ def main() -> None:
     ap.add_argument("--budget", type=float, default=20.0, help="wall-time budget per run, seconds (default 20)")
     ap.add_argument("--k0", default=",".join(map(str, K0)), help="comma-separated k0 values of the (k0, V) grid")
     args = ap.parse_args()
-    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
+    warm_up(micro.stationary, micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")
     rows = []
 
     def report(row):
         rows.append(row)
-        pd.DataFrame(rows).to_csv(HERE / "results" / "micro_stress.csv", index=False)  # keep what is done
+        write_csv(rows, OUT)  # keep what is done
         flag = "FAIL " + row["problems"] if row["problems"] else "ok"
         print(f"k0={row['k0']:<7g} V={row['V']:<7g} eps={row['eps']:<7.4g} {row['regime']:>10} "
               f"converged={row['converged']!s:5} sigma={row['sigma_mean']:.6f} "
@@ -90,7 +86,7 @@ def main() -> None:
     report(check(model, 10.0, model.kappa * model.zbar / 1000.0, 5.0 * args.budget))
     # a long run: 2000 time units (1800 relaxation times, 40000 jumps per block) of
     # steady sliding, the stress averaged over its first and last tenths
-    t = time.perf_counter()
+    sw = Stopwatch()
     run = micro.simulate(micro.Model(k0=0.1), 2.0, duration=2000.0, numerics=micro.Numerics(eps=0.024))
     rec = run.records
     early = rec[(rec.t > 100) & (rec.t < 300)].sigma_mean.mean()
@@ -100,7 +96,7 @@ def main() -> None:
         problems.append(f"density check: mass error {run.mass_error:.2g}, min mass {run.min_mass:.2g}")
     if abs(late - early) > 2e-5:
         problems.append(f"drift {late - early:.2g} between the first and last tenth")
-    rows.append(dict(k0=0.1, V=2.0, eps=0.024, t_end=2000.0, wall_s=time.perf_counter() - t, regime="long run",
+    rows.append(dict(k0=0.1, V=2.0, eps=0.024, t_end=2000.0, wall_s=sw.seconds, regime="long run",
                      converged=True, sigma_mean=late, mass_error=run.mass_error, min_mass=run.min_mass,
                      message=f"mean stress {early:.7f} (t 100-300) and {late:.7f} (t 1800-2000)",
                      problems="; ".join(problems)))
@@ -114,8 +110,7 @@ def main() -> None:
             rows.append(dict(k0=0.1, V=2.0, eps=eps, problems="out-of-range eps accepted"))
         except ValueError as exc:
             print(f"eps={eps:g} refused: {exc}")
-    table = pd.DataFrame(rows)
-    table.to_csv(HERE / "results" / "micro_stress.csv", index=False)
+    table = write_csv(rows, OUT)
     failed = table.problems.fillna("").astype(bool)
     refused = table.regime == "refused"
     unconverged = ~table.converged.fillna(False).astype(bool) & ~refused

@@ -42,13 +42,17 @@ from pathlib import Path
 
 import pandas as pd
 
-OUT = Path(__file__).resolve().parent / "results" / "micro_threads_contention.csv"
+from _harness import RESULTS, Stopwatch, write_csv
+
+OUT = RESULTS / "micro_threads_contention.csv"
 
 WORKLOADS = {
     "cohort": 'micro.stationary(micro.Model(k0=0.01), 4.0, method="cohort")',
     "renewal": "micro.steady_sliding(micro.Model(k0=0.1), np.logspace(-1, 3, 100))",
 }
 
+# Each copy times itself (wall and CPU around the call alone): it runs in a fresh
+# interpreter with the variant's PYTHONPATH, where the harness (_harness) is not importable.
 CHILD = r"""
 import json, os, sys, time
 t0 = time.perf_counter()
@@ -114,9 +118,9 @@ def batch(workload: str, k: int, env: dict[str, str], timeout: float) -> list[di
 def compile_once(workload: str, env: dict[str, str]) -> dict:
     """One process runs ``workload`` once: numba compiles what its disk cache lacks."""
     load1, runnable = _load()
-    start = time.perf_counter()
+    sw = Stopwatch()
     subprocess.run([sys.executable, "-c", f"import numpy as np, micro; {WORKLOADS[workload]}"], check=True, env=env)
-    return {"workload": workload, "phase": "compile", "k": 1, "copy": 1, "wall_s": time.perf_counter() - start,
+    return {"workload": workload, "phase": "compile", "k": 1, "copy": 1, "wall_s": sw.seconds,
             "load1_start": load1, "others_runnable": runnable, "load1_end": _load()[0]}
 
 
@@ -178,8 +182,7 @@ def main() -> None:
         done = set(zip(frame["label"], frame["workload"]))
         old = old[[pair not in done for pair in zip(old["label"], old["workload"])]]
         frame = pd.concat([old, frame], ignore_index=True)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(args.out, index=False)
+    write_csv(frame, args.out)
     # the verdict: a copy's median wall time at k at once, against k times one alone
     runs = frame[frame["phase"] == "run"]
     for w in workloads:

@@ -19,15 +19,12 @@ Writes benchmarks/results/micro_vc_convergence.csv.
 from __future__ import annotations
 
 import argparse
-import time
-from pathlib import Path
 
 import pandas as pd
 
 import micro
-from _budget import VC_RS, merged
+from _harness import RESULTS, VC_RS, Stopwatch, warm_up, write_csv
 
-HERE = Path(__file__).resolve().parent
 
 
 def main() -> None:
@@ -37,14 +34,14 @@ def main() -> None:
     ap.add_argument("--refine", choices=("yes", "no", "both"), default="yes",
                     help="check oscillations smaller than 2 eps at eps / 2 (critical_velocity's refine)")
     args = ap.parse_args()
-    micro.stationary(micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")  # compile
-    out = HERE / "results" / "micro_vc_convergence.csv"
+    warm_up(micro.stationary, micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")
+    out = RESULTS / "micro_vc_convergence.csv"
     refines = {"yes": (True,), "no": (False,), "both": (False, True)}[args.refine]
     rows = []
     for k0 in (float(k) for k in args.k0.split(",")):
         model = micro.Model(k0=k0)
         for eps, refine in ((float(e), r) for e in args.eps.split(",") for r in refines):
-            t = time.perf_counter()
+            sw = Stopwatch()
             crit = micro.critical_velocity(model, V_guess=VC_RS[k0], factor=1.5, numerics=micro.Numerics(eps=eps),
                                            refine=refine, method="fp")
             evals = pd.DataFrame(crit.evaluations)
@@ -53,7 +50,7 @@ def main() -> None:
             checked = int(evals.amplitude_fine.notna().sum())
             rows.append(dict(crit.to_dict(), eps=eps, refine=int(refine), evaluations=len(evals),
                              unconverged=unconverged, grid_cycles=grid_cycles, checked_at_half_eps=checked,
-                             wall_s=time.perf_counter() - t))
+                             wall_s=sw.seconds))
             print(evals[["V", "regime", "label", "started_from", "sigma_max", "sigma_min", "amplitude",
                          "amplitude_fine", "converged", "t_end", "wall_time", "wall_time_fine"]].to_string(index=False),
                   flush=True)
@@ -61,7 +58,7 @@ def main() -> None:
                   f"{crit.V_high:.4f}] ({crit.status}; {len(evals)} runs, {unconverged} unconverged, {checked} "
                   f"checked at eps / 2, {grid_cycles} cycles taken for the grid's; {rows[-1]['wall_s']:.0f} s)",
                   flush=True)
-            merged(out, pd.DataFrame(rows[-1:]), ["k0", "eps", "refine"]).to_csv(out, index=False)
+            write_csv(pd.DataFrame(rows[-1:]), out, keys=["k0", "eps", "refine"])
     print(pd.read_csv(out).to_string(index=False))
 
 

@@ -2,7 +2,7 @@
 
 For limit cycles whose slide phases go through CVODE (stick -> slide -> slip) and one
 without slides, prints for each rtol the largest errors of sigma_max, sigma_min,
-sigma_mean and the period (relative) against ``rsf.reference.reference_cycle``
+sigma_mean and the period (relative) against ``rsf.reference_cycle``
 (closed-form stick, quadrature slide, scipy roots), the number of right-hand-side
 evaluations per slide and the run time per limit cycle (median of repeats, after
 compilation).
@@ -14,12 +14,12 @@ from __future__ import annotations
 import os
 import statistics
 import sys
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # the repository
 
 import rsf  # noqa: E402
-from rsf.reference import reference_cycle  # noqa: E402
+
+from _harness import timed, warm_up  # noqa: E402
 
 CASES = [
     ("Eq.10 k0=0.3  V=0.05", rsf.SpringSlider(k0=0.3), 0.05),
@@ -33,9 +33,9 @@ REPEAT = 7
 
 
 def main() -> None:
-    refs = {name: reference_cycle(model, V) for name, model, V in CASES}
-    for name, model, V in CASES:            # compile / load the kernels
-        rsf.limit_cycle(model, V)
+    refs = {name: rsf.reference_cycle(model, V) for name, model, V in CASES}
+    warm_up(lambda: [rsf.limit_cycle(model, V) for _, model, V in CASES],
+            label="compilation (or numba's cache) and a first limit cycle of each case")
     print(f"{'case':<34} {'rtol':>7} {'|d sigma_max|':>14} {'|d sigma_min|':>14} "
           f"{'|d sigma_mean|':>15} {'|dT|/T':>9} {'time/cycle-search':>18}")
     for name, model, V in CASES:
@@ -44,9 +44,8 @@ def main() -> None:
             opts = rsf.SolverOptions(rtol=rtol, atol=rtol * 1e-2, cycle_rtol=1e-13)
             times = []
             for _ in range(REPEAT):
-                t0 = time.perf_counter()
-                r = rsf.limit_cycle(model, V, options=opts)
-                times.append(time.perf_counter() - t0)
+                r, seconds = timed(rsf.limit_cycle, model, V, options=opts)
+                times.append(seconds)
             assert r.converged and r.sequence == ref.sequence, (name, rtol, r.message)
             print(f"{name:<34} {rtol:>7.0e} {abs(r.sigma_max - ref.sigma_max):>14.2e} "
                   f"{abs(r.sigma_min - ref.sigma_min):>14.2e} {abs(r.sigma_mean - ref.sigma_mean):>15.2e} "

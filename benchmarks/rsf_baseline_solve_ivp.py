@@ -14,7 +14,6 @@ Run ``python benchmarks/rsf_baseline_solve_ivp.py`` for a few points.
 from __future__ import annotations
 
 import math
-import time
 
 from scipy.integrate import solve_ivp
 
@@ -121,7 +120,8 @@ def cycle_stats(model: Paper, V: float, cycle_rtol: float = 1e-6, rtol: float = 
 
 
 if __name__ == "__main__":
+    from _harness import timed
+
     for k0, V in [(0.3, 0.05), (0.3, 0.15), (0.01, 1.0), (0.01, 20.0)]:
-        t0 = time.perf_counter()
-        out = cycle_stats(Paper(k0), V)
-        print(f"k0={k0:<7g} V={V:<7g} {time.perf_counter() - t0:7.3f} s  {out}")
+        out, seconds = timed(cycle_stats, Paper(k0), V)
+        print(f"k0={k0:<7g} V={V:<7g} {seconds:7.3f} s  {out}")

@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 
 import numpy as np
 
@@ -23,6 +22,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # the repository
 
 import rsf  # noqa: E402
+from _harness import Stopwatch, timed, warm_up  # noqa: E402
 from rsf_baseline_solve_ivp import Paper, cycle_stats  # noqa: E402
 
 K0S = [0.3, 0.1, 0.01, 0.001, 0.0001]
@@ -37,10 +37,10 @@ def grid(k0: float) -> np.ndarray:
 
 def run_rsf(options: rsf.SolverOptions) -> tuple[float, dict]:
     out = {}
-    t0 = time.perf_counter()
+    sw = Stopwatch()
     for k0 in K0S:
         out[k0] = rsf.sweep(rsf.SpringSlider(k0=k0), grid(k0), options=options)
-    return time.perf_counter() - t0, out
+    return sw.seconds, out
 
 
 def main() -> None:
@@ -49,11 +49,9 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
 
-    t0 = time.perf_counter()
-    for k0, V in ((0.3, 0.05), (0.3, 0.15), (0.3, 1.0), (1e-4, 100.0)):   # every kernel once
-        rsf.limit_cycle(rsf.SpringSlider(k0=k0), V, options=OPTIONS)
-    first = time.perf_counter() - t0
-    print(f"first calls (numba compilation or cache load, CVODE set-up): {first:.2f} s")
+    warm_up(lambda: [rsf.limit_cycle(rsf.SpringSlider(k0=k0), V, options=OPTIONS)   # every kernel once
+                     for k0, V in ((0.3, 0.05), (0.3, 0.15), (0.3, 1.0), (1e-4, 100.0))],
+            label="first calls (numba compilation or cache load, CVODE set-up)")
 
     times = []
     for _ in range(args.repeat):
@@ -82,9 +80,8 @@ def main() -> None:
         same = 0
         cycles = 0
         for i in idx:
-            t1 = time.perf_counter()
-            b = cycle_stats(Paper(k0), float(V[i]), cycle_rtol=1e-6, rtol=1e-9)
-            t_b += time.perf_counter() - t1
+            b, seconds = timed(cycle_stats, Paper(k0), float(V[i]), cycle_rtol=1e-6, rtol=1e-9)
+            t_b += seconds
             r = res[k0][i]
             same += b["regime"] == r.regime
             cycles = max(cycles, b["cycles"])

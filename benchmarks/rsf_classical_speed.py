@@ -35,7 +35,6 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -57,7 +56,10 @@ def measure(repeat: int) -> list[dict]:
     import numpy as np
 
     import rsf
+    # the tests' independent reference (scipy, no code shared with rsf), not a name of rsf
     from _independent_rs import mu_at
+
+    from _harness import timed
 
     rows = []
     for law, k_over_kc, rtol in _cases():
@@ -72,14 +74,11 @@ def measure(repeat: int) -> list[dict]:
             return rsf.simulate(model, protocol=protocol, t_end=T_END, options=options,
                                 initial=initial)
 
-        start = time.process_time()
-        tr = run()
-        first = time.process_time() - start
+        tr, first = timed(run, cpu=True)      # the compilation or cache load: kept apart
         times = []
         for _ in range(repeat):
-            start = time.process_time()
-            tr = run()
-            times.append(time.process_time() - start)
+            tr, seconds = timed(run, cpu=True)
+            times.append(seconds)
         t, index = np.unique(tr.t, return_index=True)    # a sample repeated at a step: once
         mu = mu_at(law, a=A, b=B, Dc=DC, k0=k0, v0=V0, mu0=MU0, velocities=[1.0, v1],
                    times=[0.0, T_STEP], t_eval=t)
@@ -124,6 +123,8 @@ def main(argv: list[str] | None = None) -> None:
 
     import pandas as pd
 
+    from _harness import write_csv
+
     codes = {f"{_describe(ROOT)} (this checkout)": ROOT}
     tmp = None
     if args.against:
@@ -157,9 +158,7 @@ def main(argv: list[str] | None = None) -> None:
                              cpu_ms_first_median=statistics.median(first),
                              load_1min_before=load_before[0], load_1min_after=load_after[0],
                              cpus=os.cpu_count()))
-    table = pd.DataFrame(rows)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    table.to_csv(args.out, index=False, float_format="%.6g")
+    table = write_csv(pd.DataFrame(rows), args.out, float_format="%.6g")
     shown = table[["code", "law", "k_over_kc", "rtol", "n_samples", "err_sigma", "cpu_ms_min",
                    "cpu_ms_median", "cpu_ms_first_median"]]
     print(shown.to_string(index=False, float_format=lambda x: f"{x:.4g}"))

@@ -14,14 +14,13 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # the repository
 
 import rsf  # noqa: E402
-from rsf.analysis import fit_power_law  # noqa: E402
+from _harness import Stopwatch, pyplot, save_figure  # noqa: E402
 
 K0S = [0.3, 0.1, 0.01, 0.001, 0.0001]
 EPS = np.geomspace(1e-8, 1e-1, 15)
@@ -32,7 +31,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--plot", default=None, help="write a log-log figure to this PNG")
     args = parser.parse_args()
-    t0 = time.perf_counter()
+    sw = Stopwatch()
     fits = {}
     print(f"{'k0':>7} {'Vc':>10} {'beta (eps<=1e-5)':>20} {'beta (1e-3..1e-1)':>20} "
           f"{'spread sigma_min/amp (far)':>27} {'converged':>10}")
@@ -41,7 +40,7 @@ def main() -> None:
         fit = rsf.hopf_scaling(model, EPS, fit_max=1e-5, options=OPTIONS)
         x = fit.epsilon * fit.Vc
         far = (fit.epsilon >= 1e-3)
-        b_far, db_far, _, _ = fit_power_law(x[far], fit.amplitude[far])
+        b_far, db_far, _, _ = rsf.fit_power_law(x[far], fit.amplitude[far])
         spread = np.ptp(fit.sigma_min[far]) / fit.amplitude[far].max()
         fits[k0] = fit
         print(f"{k0:>7g} {fit.Vc:>10.5g} {fit.exponent:>11.5f} +- {fit.exponent_stderr:.1e} "
@@ -71,14 +70,9 @@ def main() -> None:
         below = rsf.limit_cycle(model, cv.V_lower * (1 - 1e-6), options=OPTIONS)
         print(f"  k0={k0:<7g} V_lower={cv.V_lower:.5g}: eps=1e-2,1e-4,1e-6 -> {', '.join(amps)}; "
               f"just below: {below.regime}")
-    print(f"\ntotal {time.perf_counter() - t0:.1f} s")
+    print(f"\ntotal {sw.seconds:.1f} s")
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(5.5, 4.2))
+        fig, ax = pyplot().subplots(figsize=(5.5, 4.2))
         for k0, fit in fits.items():
             ax.loglog(fit.epsilon, fit.amplitude, "o-", ms=3, label=f"k0 = {k0:g}")
         ax.loglog(EPS[:8], 0.1 * EPS[:8] ** 0.5, "k--", lw=0.8, label="slope 1/2")
@@ -87,8 +81,7 @@ def main() -> None:
         ax.set_ylabel("sigma_max - sigma_min")
         ax.legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(args.plot, dpi=120)
-        print(f"wrote {args.plot}")
+        save_figure(fig, args.plot)
 
 
 if __name__ == "__main__":

@@ -17,7 +17,6 @@ from __future__ import annotations
 import os
 import statistics
 import sys
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -25,10 +24,12 @@ sys.path.insert(0, str(ROOT))                         # the repository
 sys.path.insert(0, str(ROOT / "tests" / "rsf"))       # the independent reference
 
 import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
 
 import rsf  # noqa: E402
+# the tests' independent reference (scipy, no code shared with rsf), not a name of rsf
 from _independent_rs import mu_at  # noqa: E402
+
+from _harness import RESULTS, timed, warm_up, write_csv  # noqa: E402
 
 A, B, DC, V0, MU0 = 0.005, 0.01, 10.0, 1.0, 0.6
 KC = (B - A) / DC
@@ -58,17 +59,15 @@ def main() -> None:
         proto = rsf.Protocol.velocity_steps(vel, [10.0, 40.0])
         mu_ref = mu_at(ref_law, a=A, b=B, Dc=DC, k0=k0, v0=V0, mu0=MU0, velocities=vel,
                        times=[0.0, 10.0, 50.0], t_eval=TE, **extra)
-        rsf.simulate(model, protocol=proto, t_end=100.0, t_eval=TE)     # compile / warm up
+        warm_up(rsf.simulate, model, protocol=proto, t_end=100.0, t_eval=TE, label=f"{name}: first call")
         for rtol in RTOLS:
             opts = rsf.SolverOptions(rtol=rtol, atol=rtol * 1e-2)
             t_out, t_steps = [], []
             for _ in range(REPEAT):
-                t0 = time.perf_counter()
-                tr = rsf.simulate(model, protocol=proto, t_end=100.0, t_eval=TE, options=opts)
-                t_out.append(time.perf_counter() - t0)
-                t0 = time.perf_counter()
-                full = rsf.simulate(model, protocol=proto, t_end=100.0, options=opts)
-                t_steps.append(time.perf_counter() - t0)
+                tr, seconds = timed(rsf.simulate, model, protocol=proto, t_end=100.0, t_eval=TE, options=opts)
+                t_out.append(seconds)
+                full, seconds = timed(rsf.simulate, model, protocol=proto, t_end=100.0, options=opts)
+                t_steps.append(seconds)
             assert tr.success and full.success, (name, tr.message, full.message)
             err = float(np.max(np.abs(tr.sigma - mu_ref)))
             err_interp = float(np.max(np.abs(np.interp(TE, full.t, full.sigma) - mu_ref)))
@@ -83,13 +82,12 @@ def main() -> None:
     step = rsf.Protocol.velocity_steps([1.0, 10.0], [10.0])
     walls = []
     for _ in range(REPEAT):
-        t0 = time.perf_counter()
-        tr = rsf.simulate(runaway, protocol=step, t_end=60.0)
-        walls.append(time.perf_counter() - t0)
+        tr, seconds = timed(rsf.simulate, runaway, protocol=step, t_end=60.0)
+        walls.append(seconds)
     print(f"runaway (aging, k0 = 0.8 k_c, step 1 -> 10): status {tr.status}, "
           f"{1e3 * statistics.median(walls):.1f} ms; {tr.message}")
-    out = ROOT / "benchmarks" / "results" / "rsf_teval_accuracy.csv"
-    pd.DataFrame(rows).to_csv(out, index=False)
+    out = RESULTS / "rsf_teval_accuracy.csv"
+    write_csv(rows, out)
     print(f"wrote {out.relative_to(ROOT)}")
 
 
