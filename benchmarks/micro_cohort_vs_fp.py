@@ -4,7 +4,7 @@ Reads the results of other benchmarks (no new runs) and plots wall time against 
 error of sigma_max and sigma_min (the larger of the two), log-log:
 
 * k0 = 0.01, V = 1 (about V^c / 8): the reference is the N-block at N = 1e6
-  (benchmarks/results/micro_stickslip_speed.csv, which also holds the Fokker-Planck
+  (benchmarks/results/micro_fp_vs_nblock_stickslip.csv, which also holds the Fokker-Planck
   time-stepping at eps = 0.024 ... 0.006 and the N-block at N = 1e3 ... 1e6); the cohort
   rows are benchmarks/micro_cohort_refinement.py --k0 0.01 --fraction 0.12482899.
 * k0 = 1e-3 and 0.01, V = 0.3 V^c: the reference is the cohorts' Richardson limit for
@@ -25,7 +25,7 @@ from _harness import RESULTS, pyplot, save_figure, write_csv
 def main() -> None:
     rows = []
     # k0 = 0.01, V = 1: against the N-block at N = 1e6
-    speed = pd.read_csv(RESULTS / "micro_stickslip_speed.csv")
+    speed = pd.read_csv(RESULTS / "micro_fp_vs_nblock_stickslip.csv")
     ref = speed[(speed.solver == "nblock") & (speed.resolution == speed[speed.solver == "nblock"].resolution.max())]
     ref_max, ref_min = float(ref.sigma_max.iloc[0]), float(ref.sigma_min.iloc[0])
     for _, r in speed[speed.solver.isin(["fp", "nblock"])].iterrows():

@@ -14,7 +14,7 @@ and the Fokker-Planck's stored steady stresses scored against the exact stress.
    decreasing in V, points that miss tol, worst errors, and the time of the growth rate.
 5. ``waiting``: the Newton waiting time against a 40-digit root (needs ``pip install
    mpmath``, not a dependency of the project; skipped without it).
-6. ``fp``: the rows of results/micro_eps_convergence.csv (Fokker-Planck steady stress
+6. ``fp``: the rows of results/micro_fp_eps_convergence.csv (Fokker-Planck steady stress
    against the bin eps) with their true error against the exact stress, and the measured
    order of the FP in eps (least squares of log error on log eps).
 
@@ -136,7 +136,7 @@ def waiting_time_accuracy() -> float | None:
 
 
 def fp_table() -> tuple[pd.DataFrame, pd.DataFrame]:
-    fp = pd.read_csv(RESULTS / "micro_eps_convergence.csv")
+    fp = pd.read_csv(RESULTS / "micro_fp_eps_convergence.csv")
     fp = fp[(fp.regime == "steady") & fp.converged.astype(bool)].copy()
     fp["sigma_exact"] = [float(micro.steady_sliding(micro.Model(k0=k0), V, growth_rate=False).sigma)
                          for k0, V in zip(fp.k0, fp.V)]

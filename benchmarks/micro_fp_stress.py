@@ -10,10 +10,10 @@ one of these prints FAIL; the script exits non-zero if any does.  A run whose gr
 outgrows the memory limit ends with micro.GridTooLarge, a clear refusal (regime
 "refused"), which is not a failure.
 
-Writes benchmarks/results/micro_stress.csv.
+Writes benchmarks/results/micro_fp_stress.csv.
 
-    python benchmarks/micro_stress.py              # about 20 minutes on one core
-    python benchmarks/micro_stress.py --budget 5   # quicker, more runs end unconverged
+    python benchmarks/micro_fp_stress.py              # about 20 minutes on one core
+    python benchmarks/micro_fp_stress.py --budget 5   # quicker, more runs end unconverged
 """
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ import sys
 import micro
 from _harness import RESULTS, Stopwatch, capped_t_max, warm_up, write_csv
 
-OUT = RESULTS / "micro_stress.csv"
+OUT = RESULTS / "micro_fp_stress.csv"
 K0 = (1e-4, 1e-3, 1e-2, 0.1, 1.0)
 V = (1e-4, 1e-2, 1.0, 1e2, 1e3)
 #: largest simulated time of a run (the calibration underestimates the cost of slow

@@ -17,11 +17,11 @@ sigma(V) - sigma_inf ~ k2 gamma Var(R) / V ~ k0 zbar, shrinks with k0 while the
 discretisation error does not.  The table says, per k0, which bins reached an error below
 1 % of the weakening.
 
-Writes benchmarks/results/micro_eps_convergence.csv and docs/figures/micro_eps_convergence.png.
+Writes benchmarks/results/micro_fp_eps_convergence.csv and docs/figures/micro_fp_eps_convergence.png.
 
-    python benchmarks/micro_eps_convergence.py            # about 15 minutes on one core
-    python benchmarks/micro_eps_convergence.py --budget 60  # shorter cap per run (seconds)
-    python benchmarks/micro_eps_convergence.py --k0 0.001 --eps 0.008,0.004 --t-max 40
+    python benchmarks/micro_fp_eps_convergence.py            # about 15 minutes on one core
+    python benchmarks/micro_fp_eps_convergence.py --budget 60  # shorter cap per run (seconds)
+    python benchmarks/micro_fp_eps_convergence.py --k0 0.001 --eps 0.008,0.004 --t-max 40
         # some points only, capped in simulated time; replaces those rows of the CSV
 """
 from __future__ import annotations
@@ -82,7 +82,7 @@ def main() -> None:
     ap.add_argument("--eps", type=str, default=",".join(map(str, EPS)), help="comma-separated bins, coarse to fine")
     ap.add_argument("--replot", action="store_true", help="redo the table and plot from the CSV of a previous run")
     args = ap.parse_args()
-    out = RESULTS / "micro_eps_convergence.csv"
+    out = RESULTS / "micro_fp_eps_convergence.csv"
     columns = ["k0", "V", "eps", "regime", "converged", "sigma", "sigma_stderr", "t_end", "t_max", "wall_s",
                "mass_error", "min_mass", "message"]
     if args.replot:
@@ -143,7 +143,7 @@ def main() -> None:
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    save_figure(fig, FIGURES / "micro_eps_convergence.png")
+    save_figure(fig, FIGURES / "micro_fp_eps_convergence.png")
 
 
 if __name__ == "__main__":

@@ -3,16 +3,16 @@
 Point: k0 = 1e-3, V = 174.75 (Fig. 10's point, 1.5 times the RS V^c; Fig. 4 parameters),
 steady sliding.  Reference: the large-V law ``micro.sigma_fast_limit`` (its neglected
 O(V^-2) term is ~3e-8 here).  The Fokker-Planck rows are those of
-benchmarks/results/micro_eps_convergence.csv (run micro_eps_convergence.py for k0 = 0.001
+benchmarks/results/micro_fp_eps_convergence.csv (run micro_fp_eps_convergence.py for k0 = 0.001
 first).  The N-block solver is run here for growing N; near V^c its finite-N system
 slips in global shocks, so its error is a finite-size bias that falls slowly with N.
 Its error and wall time are fitted as powers of N, and the wall time it would need to
 match each Fokker-Planck error is extrapolated from them (said so in the output: such N
 are far beyond what can be run).
 
-Writes benchmarks/results/micro_small_k0_speed.csv.
+Writes benchmarks/results/micro_fp_vs_nblock_small_k0.csv.
 
-    python benchmarks/micro_small_k0_speed.py            # about 5 minutes
+    python benchmarks/micro_fp_vs_nblock_small_k0.py            # about 5 minutes
 """
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ def main() -> None:
     a_err, c_err = np.polyfit(np.log(nb.N), np.log(np.abs(nb.error)), 1)
     a_t, c_t = np.polyfit(np.log(nb.N), np.log(nb.wall_s), 1)
     print(f"N-block: |error| ~ N^{a_err:.2f}, wall ~ N^{a_t:.2f}")
-    fp = pd.read_csv(RESULTS / "micro_eps_convergence.csv")
+    fp = pd.read_csv(RESULTS / "micro_fp_eps_convergence.csv")
     fp = fp[(fp.k0 == K0) & fp.converged.astype(bool)].sort_values("eps", ascending=False)
     for _, row in fp.iterrows():
         err = abs(row.sigma - ref)
@@ -58,7 +58,7 @@ def main() -> None:
                          nblock_N_needed=n_need, nblock_wall_s_extrapolated=t_need, speedup=t_need / row.wall_s))
         print(f"FP eps = {row.eps:g}: error {row.sigma - ref:+.2e} in {row.wall_s:.0f} s; the N-block would need "
               f"N ~ {n_need:.2g} and ~{t_need:.2g} s (extrapolated): {t_need / row.wall_s:.2g}x", flush=True)
-    table = write_csv(rows, RESULTS / "micro_small_k0_speed.csv")
+    table = write_csv(rows, RESULTS / "micro_fp_vs_nblock_small_k0.csv")
     print(table.to_string(index=False))
 
 

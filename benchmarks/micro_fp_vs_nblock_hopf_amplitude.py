@@ -8,15 +8,15 @@ amplitude at every bin and N; an oscillation of the grid shrinks with eps (near 
 reaches ~2 eps), and the N-block's finite-N noise falls like N^-1/2.  This is the independent check of the
 bisection's V^c (`micro.critical_velocity`).
 
-Writes benchmarks/results/micro_hopf_amplitude.csv (rows merge by k0, k1, k2, resolution and V; a bin
+Writes benchmarks/results/micro_fp_vs_nblock_hopf_amplitude.csv (rows merge by k0, k1, k2, resolution and V; a bin
 eps < 1 never equals an N).  A run lasts at least 30 block cycles (30 zbar / V); one made longer
 has its windows lengthened by the same factor.
 
-    python benchmarks/micro_hopf_amplitude.py                              # k0 = 0.1
-    python benchmarks/micro_hopf_amplitude.py --solver fp --eps 0.004 --V 0.8,0.9
-    python benchmarks/micro_hopf_amplitude.py --solver nblock --N 1e6 --t-max 60
-    python benchmarks/micro_hopf_amplitude.py --k0 0.3 --k1 0.5 --k2 0.5 --solver nblock --V 0.02,0.04,0.06
-    python benchmarks/micro_hopf_amplitude.py --k0 0.01 --solver nblock --V 7,7.5,8,8.5,9.5 --t-max 80
+    python benchmarks/micro_fp_vs_nblock_hopf_amplitude.py                              # k0 = 0.1
+    python benchmarks/micro_fp_vs_nblock_hopf_amplitude.py --solver fp --eps 0.004 --V 0.8,0.9
+    python benchmarks/micro_fp_vs_nblock_hopf_amplitude.py --solver nblock --N 1e6 --t-max 60
+    python benchmarks/micro_fp_vs_nblock_hopf_amplitude.py --k0 0.3 --k1 0.5 --k2 0.5 --solver nblock --V 0.02,0.04,0.06
+    python benchmarks/micro_fp_vs_nblock_hopf_amplitude.py --k0 0.01 --solver nblock --V 7,7.5,8,8.5,9.5 --t-max 80
 """
 from __future__ import annotations
 
@@ -97,7 +97,7 @@ def main() -> None:
     model = micro.Model(k0=args.k0, k1=args.k1, k2=args.k2)
     Vs = [float(v) for v in args.V.split(",")]
     V_start = args.V_start if args.V_start is not None else max(2.0, 1.5 * max(Vs))
-    out = RESULTS / "micro_hopf_amplitude.csv"
+    out = RESULTS / "micro_fp_vs_nblock_hopf_amplitude.csv"
     runs = []
     if args.solver in ("fp", "both"):
         runs += [("fp", float(e)) for e in args.eps.split(",")]

@@ -8,13 +8,13 @@ guess (the RS V^c of Eq. (12) with the paper's A, B, D_c).  With ``--refine yes`
 default of `critical_velocity`) an oscillation smaller than 2 eps is rerun at eps / 2 and
 counts as stick-slip only if it keeps its amplitude; ``no`` is the rule without that check
 (a cycle without global shocks below min(10 k0 eps, 2 eps) counts as steady).  The
-independent check is `micro_hopf_amplitude.py` (cycle amplitudes of both solvers against V).
+independent check is `micro_fp_vs_nblock_hopf_amplitude.py` (cycle amplitudes of both solvers against V).
 
-Writes benchmarks/results/micro_vc_convergence.csv.
+Writes benchmarks/results/micro_fp_vc_convergence.csv.
 
-    python benchmarks/micro_vc_convergence.py                      # k0 = 0.1, three bins
-    python benchmarks/micro_vc_convergence.py --k0 0.3 --eps 0.016,0.008
-    python benchmarks/micro_vc_convergence.py --k0 0.1,0.3 --eps 0.024,0.016 --refine both
+    python benchmarks/micro_fp_vc_convergence.py                      # k0 = 0.1, three bins
+    python benchmarks/micro_fp_vc_convergence.py --k0 0.3 --eps 0.016,0.008
+    python benchmarks/micro_fp_vc_convergence.py --k0 0.1,0.3 --eps 0.024,0.016 --refine both
 """
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ def main() -> None:
                     help="check oscillations smaller than 2 eps at eps / 2 (critical_velocity's refine)")
     args = ap.parse_args()
     warm_up(micro.stationary, micro.Model(k0=0.1), 2.0, numerics=micro.Numerics(eps=0.024), method="fp")
-    out = RESULTS / "micro_vc_convergence.csv"
+    out = RESULTS / "micro_fp_vc_convergence.csv"
     refines = {"yes": (True,), "no": (False,), "both": (False, True)}[args.refine]
     rows = []
     for k0 in (float(k) for k in args.k0.split(",")):

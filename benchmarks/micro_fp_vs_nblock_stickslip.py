@@ -20,11 +20,11 @@ range; for it the script gives a lower bound: the wall time the largest N needs 
 statistical error alone (standard error over the cycles, falling like cycles^-1/2) to
 reach that error.  Compilation is excluded.
 
-Writes benchmarks/results/micro_stickslip_speed.csv (rows merge by solver and
+Writes benchmarks/results/micro_fp_vs_nblock_stickslip.csv (rows merge by solver and
 resolution, so a run with `--N 1e6` alone adds that row).
 
-    python benchmarks/micro_stickslip_speed.py                  # about 15 minutes
-    python benchmarks/micro_stickslip_speed.py --solver nblock --N 1e6   # about 45 minutes
+    python benchmarks/micro_fp_vs_nblock_stickslip.py                  # about 15 minutes
+    python benchmarks/micro_fp_vs_nblock_stickslip.py --solver nblock --N 1e6   # about 45 minutes
 """
 from __future__ import annotations
 
@@ -163,7 +163,7 @@ def main() -> None:
         rows += fp_rows(model, [float(e) for e in args.eps.split(",")])
     if args.solver in ("nblock", "both"):
         rows += nblock_rows(model, [int(float(n)) for n in args.N.split(",")])
-    out = RESULTS / "micro_stickslip_speed.csv"
+    out = RESULTS / "micro_fp_vs_nblock_stickslip.csv"
     keep = ["solver", "resolution", "regime", "converged", "sigma_max", "sigma_min", "period", "sigma_max_stderr",
             "sigma_min_stderr", "sigma_max_drift", "wall_s"]
     table = errors(merged(out, pd.DataFrame(rows), ["solver", "resolution"])[keep].reset_index(drop=True))

@@ -15,12 +15,12 @@ miss their stopping test are kept, flagged ``converged = False`` and drawn open.
 
 Writes docs/data/micro_fig{3,4,7}.csv and docs/figures/micro_fig{3,4,6,7}.png.
 
-    python benchmarks/micro_paper_figures.py               # budget 30 s per point
-    python benchmarks/micro_paper_figures.py --figs 4,6 --budget 10
-    python benchmarks/micro_paper_figures.py --figs 4,6 --k0 0.001 --ratios 0.85,1.2,2,5 --eps 0.004 --t-max 12
+    python benchmarks/micro_fp_paper_figures.py               # budget 30 s per point
+    python benchmarks/micro_fp_paper_figures.py --figs 4,6 --budget 10
+    python benchmarks/micro_fp_paper_figures.py --figs 4,6 --k0 0.001 --ratios 0.85,1.2,2,5 --eps 0.004 --t-max 12
         # some points at another bin, capped in simulated time; they replace the same
         # (k0, V) rows of docs/data/micro_fig4.csv
-    python benchmarks/micro_paper_figures.py --figs 4,6 --replot
+    python benchmarks/micro_fp_paper_figures.py --figs 4,6 --replot
 
 A converged cycle flagged as possibly the grid's oscillation (stress drop below
 10 k0 eps, see docs/reference/micro_numerics.md) is drawn as a cross at its mean stress.
