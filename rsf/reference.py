@@ -185,7 +185,7 @@ def _slide(m: _Model, rho0: float) -> tuple[_Segment | None, float, str]:
 
 @dataclass
 class ReferenceCycle:
-    """One cycle from a slip landing to the next, or steady sliding.
+    r"""One cycle from a slip landing to the next, or steady sliding.
 
     Attributes
     ----------

@@ -32,7 +32,7 @@ AGING, SLIP, PRZ, NAGATA, USER = 0, 1, 2, 3, 4
 
 
 class StateLaw:
-    """Base class: a state evolution law (see the module docstring).
+    r"""Base class: a state evolution law (see the module docstring).
 
     Not used directly: :class:`~rsf.params.SpringSlider` takes a subclass, its name, or a
     callable as ``state_law``.  Each law has a ``name``, the ``code`` the kernels
