@@ -34,7 +34,22 @@ def default_cache_dir() -> Path:
 
 
 class PointCache:
-    """Task records on disk under ``directory`` (created on first write)."""
+    """Task records on disk under ``directory`` (created on first write).
+
+    ``cache.get(key)`` returns the record or None (an unreadable file counts as missing);
+    ``cache.put(key, record)`` writes it atomically.
+
+    Parameters
+    ----------
+    directory : path, optional
+        Default :func:`default_cache_dir`: ``$COMPARE_CACHE_DIR``, else
+        ``~/.cache/frictionkit-compare``.
+
+    Raises
+    ------
+    ValueError
+        If ``directory`` exists and is not a directory.
+    """
 
     def __init__(self, directory: str | os.PathLike | None = None) -> None:
         self.directory = Path(directory) if directory is not None else default_cache_dir()
@@ -94,7 +109,8 @@ class PointCache:
 
 
 class NullCache:
-    """A cache that stores nothing (``--no-cache``)."""
+    """A cache that stores nothing (``--no-cache``): every ``get`` misses, ``put`` drops the
+    record.  It takes no parameters."""
 
     directory = None
     hits = misses = writes = 0

@@ -58,15 +58,17 @@ class SteadyLawFit:
         The fitted constants and their standard errors (from the Jacobian at the optimum,
         scaled by the residual variance).
     offsets : DataFrame
-        One row per k0: ``k0, mu_inf, mu_inf_err, n_points`` and, when the fit was given
-        a model description, ``fast_limit`` (:func:`micro.sigma_fast_limit`) and
-        ``paper_offset`` (:math:`f_{th} - \kappa\bar z/2`, the paper's Eq. (6)).
+        One row per k0: ``k0, mu_inf, mu_inf_err, n_points``.
     residuals : DataFrame
         The points used, with the fitted value and the residual.
     rms : float
         Root-mean-square residual.
     offset_mode : str
-        ``'free'`` (fitted per k0), ``'fast_limit'`` or ``'paper'`` (held fixed).
+        ``'free'`` (fitted per k0) or ``'fixed'`` (held at the given offsets).
+    n_points : int
+        Steady points in the fit.
+    params : dict
+        Unused by the fit itself (empty unless a caller records the model there).
     """
 
     A: float
@@ -138,18 +140,42 @@ def fit_steady_law(frame: pd.DataFrame, *, offset: str = "free", fixed_offsets: 
     ----------
     frame : DataFrame
         Rows with ``k0, V, regime, sigma_mean`` (and ``converged``), e.g. from
-        :func:`compare.micro_sweep`; only ``regime == 'steady'`` rows are used.
+        :func:`micro.sweep`; only ``regime == 'steady'`` rows with V > 0 and a finite
+        ``sigma_mean`` are used.
     offset : {'free', 'fixed'}
-        ``'free'``: one fitted offset per k0.  ``'fixed'``: offsets from ``fixed_offsets``
-        (a dict k0 -> mu_inf), only A and B fitted.
+        ``'free'``: one fitted offset per k0.  ``'fixed'``: offsets from ``fixed_offsets``,
+        only A and B fitted.
+    fixed_offsets : dict, optional
+        k0 -> mu_inf for every k0 of the steady rows; needed with ``offset='fixed'``.
     converged_only : bool
         Skip steady rows whose run did not meet its convergence test (default True).
     B_bounds : (float, float)
-        Search range of B, > 0.
+        Search range of B, > 0 and increasing (default (1e-4, 1e2)); an optimum at its
+        end is logged as a warning.
 
     Returns
     -------
     SteadyLawFit
+        A, B and their standard errors, the offsets per k0, the residuals and their rms.
+
+    Raises
+    ------
+    ValueError
+        If ``offset`` is not a choice, ``B_bounds`` is not positive and increasing,
+        ``frame`` lacks a column, there are fewer steady points than parameters plus one,
+        or ``offset='fixed'`` comes without ``fixed_offsets`` or without the offset of a
+        k0.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from compare import fit_steady_law
+    >>> V = np.geomspace(0.5, 50.0, 8)
+    >>> frame = pd.DataFrame({"k0": 0.1, "V": V, "regime": "steady",
+    ...                       "sigma_mean": 0.945 + 0.007 / (V + 0.078)})
+    >>> fit = fit_steady_law(frame)
+    >>> round(fit.A, 6), round(fit.B, 6), round(fit.mu_inf(0.1), 6)
+    (0.007, 0.078, 0.945)
     """
     offset = choice("offset", offset, ("free", "fixed"))
     lo, hi = positive("B_bounds[0]", B_bounds[0]), positive("B_bounds[1]", B_bounds[1])
@@ -231,7 +257,36 @@ def rs_diagram(points: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateL
     """RS attractors at the (k0, V) of ``points`` (columns ``k0, V``) with the law
     ``law_for(k0)`` and critical slip distance ``Dc``.
 
-    Returns ``k0, V, regime, sigma_max, sigma_min, sigma_mean, converged, status`` per row.
+    Parameters
+    ----------
+    points : DataFrame
+        Columns ``k0`` and ``V`` (> 0).
+    law_for : callable
+        k0 -> the RS steady-state law (an :class:`rsf.SteadyStateLaw`).
+    Dc : float
+        Critical slip distance, > 0.
+    options : rsf.SolverOptions, optional
+        For :func:`rsf.limit_cycle`; default ``cycle_rtol=1e-7, rtol=1e-8``.
+
+    Returns
+    -------
+    DataFrame
+        ``k0, V, regime, sigma_max, sigma_min, sigma_mean, converged, status`` per row of
+        ``points``.
+
+    Raises
+    ------
+    ValueError
+        If ``Dc`` is not a finite number > 0, or rsf refuses a model or velocity (a k0 or V
+        out of range, a law that is not an rsf law).
+
+    Examples
+    --------
+    >>> import pandas as pd, rsf
+    >>> from compare import rs_diagram
+    >>> rs_diagram(pd.DataFrame({"k0": [0.1, 0.1], "V": [0.05, 2.0]}),
+    ...            lambda k0: rsf.HyperbolicLaw(), Dc=0.06).regime.tolist()
+    ['stick-slip', 'steady']
     """
     Dc = positive("Dc", Dc)
     options = options or rsf.SolverOptions(cycle_rtol=1e-7, rtol=1e-8)
@@ -252,7 +307,33 @@ def dc_from_critical_velocity(A: float, B: float, k0: float, Vc: float) -> float
 
     .. math:: k_0 D_c = W(V^c) = \frac{A V^c}{(V^c + B)^2}
 
-    (the upper root V_+ of the stability boundary; valid for :math:`V^c > B`)."""
+    (the upper root V_+ of the stability boundary; valid for :math:`V^c > B`).
+
+    Parameters
+    ----------
+    A, B : float
+        The constants of Eq. (10), > 0.
+    k0 : float
+        Driving stiffness, > 0.
+    Vc : float
+        The critical velocity to match, > ``B``.
+
+    Returns
+    -------
+    float
+        :math:`D_c = A V^c / (k_0 (V^c + B)^2)`.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is not a finite number > 0, or ``Vc <= B``.
+
+    Examples
+    --------
+    >>> from compare import dc_from_critical_velocity
+    >>> round(dc_from_critical_velocity(0.007, 0.078, 0.1, 1.0046), 4)   # rsf's V^c at Dc = 0.06
+    0.06
+    """
     A, B, k0, Vc = positive("A", A), positive("B", B), positive("k0", k0), positive("Vc", Vc)
     if Vc <= B:
         raise ValueError(f"Vc must be > B = {B!r} to be the upper root V_+ of W(V) = k0 Dc, got {Vc!r}")
@@ -279,10 +360,19 @@ class DcFit:
     rms : float
         Root-mean-square residual at the optimum (stress units), over the 2n values
         (σ_max and σ_min of each point); ``rms_per_k0`` splits it by k0.
+    Dc_bootstrap : (float, float)
+        The bootstrap's 16 % and 84 % quantiles.
     profile : DataFrame
         ``Dc, rss, rms`` on the scan grid.
     points : DataFrame
-        The micro points used with the RS values at the optimum and the residuals.
+        The micro points used with the RS values at the optimum, the residuals and the
+        D_c at which each point's RS regime switches (``Dc_switch``).
+    n_points : int
+        Micro points used.
+    regime_agreement : float
+        The fraction of points whose RS regime at the optimum is micro's.
+    bootstrap : ndarray
+        The bootstrap optima.
     """
 
     Dc: float
@@ -342,7 +432,26 @@ def fit_dc(frame: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateLaw], 
     bounds : (float, float)
         Search range of D_c, > 0.
     n_grid, n_bootstrap : int
-        Scan resolution and number of bootstrap samples.
+        Scan resolution (>= 7, default 49) and number of bootstrap samples (default 400).
+    converged_only : bool
+        Skip micro points whose run did not converge (default True).
+    seed : int
+        Seed of the bootstrap's resampling.
+    options : rsf.SolverOptions, optional
+        For the RS limit cycles (:func:`rs_diagram`'s default).
+
+    Returns
+    -------
+    DcFit
+        The optimum, its bootstrap error and profile interval, the residuals, and whether
+        the data bound D_c from one side only.
+
+    Raises
+    ------
+    ValueError
+        If ``bounds`` is not positive and increasing, ``n_grid`` < 7, ``frame`` lacks a
+        column, or fewer than 3 usable (steady or stick-slip, finite, converged) points
+        remain.
     """
     lo, hi = positive("bounds[0]", bounds[0]), positive("bounds[1]", bounds[1])
     if not hi > lo:
@@ -490,6 +599,37 @@ def fit_dc_critical(k0, Vc, law_for: Callable[[float], rsf.SteadyStateLaw], *,
     the law's weakening (``Dc_law``) and, given ``slopes`` (k0 -> micro's own W at its
     V^c), with micro's (``Dc_exact_slope``): the two differ by the error of the law's
     slope.  One D_c for every k0 is the least-squares fit of the log critical velocities.
+
+    Parameters
+    ----------
+    k0, Vc : array_like
+        Stiffnesses and micro's critical velocities, 1-D, of equal length, finite and > 0.
+    law_for : callable
+        k0 -> the RS steady-state law (an :class:`rsf.SteadyStateLaw`).
+    slopes : dict, optional
+        k0 -> micro's own weakening :math:`-V\,\mathrm{d}\sigma/\mathrm{d}V` at its V^c.
+    bounds : (float, float)
+        Search range of D_c, > 0 (default (1e-3, 1)).
+
+    Returns
+    -------
+    DcCriticalFit
+        The fitted D_c, its error, the range of the per-k0 D_c and the table per k0.
+
+    Raises
+    ------
+    ValueError
+        If ``k0`` and ``Vc`` are not 1-D of equal non-zero length with finite positive
+        values, or ``bounds`` is not positive.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> from compare import fit_dc_critical
+    >>> Vc = [rsf.critical_velocity(k0=k0, Dc=0.06).Vc for k0 in (0.1, 0.3)]
+    >>> fit = fit_dc_critical([0.1, 0.3], Vc, lambda k0: rsf.HyperbolicLaw())
+    >>> round(fit.Dc, 6)
+    0.06
     """
     k0 = np.asarray(k0, dtype=float)
     Vc = np.asarray(Vc, dtype=float)
@@ -539,6 +679,20 @@ def steady_law_checks(fit: SteadyLawFit, sigma_inf: dict[float, float], tail: di
     (:math:`\mu_\infty - \sigma_\infty`), ``A, tail_exact, tail_ratio`` (A / C),
     ``max_abs_residual, V_at_max, rms`` and ``tail_residual`` (the residual at the largest V
     relative to the exact :math:`\sigma - \sigma_\infty` there).
+
+    Parameters
+    ----------
+    fit : SteadyLawFit
+        The fit of Eq. (10).
+    sigma_inf : dict
+        k0 -> the exact large-V limit :math:`\sigma_\infty` (nan where missing).
+    tail : dict
+        k0 -> the exact coefficient :math:`C` of :math:`C/V`.
+
+    Returns
+    -------
+    DataFrame
+        One row per fitted k0, with the columns above and ``V_max``.
     """
     res = fit.residuals
     rows = []
@@ -566,8 +720,28 @@ def classify_transition(spectrum: pd.DataFrame, amplitude_fits: pd.DataFrame, po
     finite frequency: the growth rate vanishes at V^c and the period of the born cycle stays
     finite, its amplitude growing like :math:`(V^c - V)^{1/2}`.  ``spectrum`` holds the growth
     rate of micro's unstable (real) mode against d = (V^c - V)/V^c; ``amplitude_fits`` the
-    fitted amplitude laws; ``points`` the N-block periods.  Returns the numbers and a
-    one-paragraph verdict (``text``).
+    fitted amplitude laws; ``points`` the N-block periods.
+
+    Parameters
+    ----------
+    spectrum : DataFrame
+        Columns ``d`` and ``growth_rate``; the growth test needs two finite rates.
+    amplitude_fits : DataFrame
+        Columns ``model, method, resolution, exponent, exponent_err``: the N-block fits of
+        micro (``model == 'micro'``, ``method == 'N-block'``) give beta, the largest N its
+        value.
+    points : DataFrame
+        Columns ``model, method, regime, resolution, d, period``: the periods of micro's
+        N-block cycles at the largest N give the period exponent (at least 3 needed).
+
+    Returns
+    -------
+    dict
+        What could be measured of ``d_near, growth_near, d_far, growth_far,
+        growth_diverges``, ``beta, beta_err, beta_spread, beta_N`` and ``period_exponent,
+        period_near, d_period_near``; ``hopf`` (True, False, or None without a spectrum)
+        and ``text``, the verdict as a paragraph.  Evidence that is missing is left out,
+        not an error.
     """
     out: dict[str, Any] = {}
     sp = spectrum[np.isfinite(spectrum.growth_rate)].sort_values("d")
@@ -624,7 +798,24 @@ def classify_transition(spectrum: pd.DataFrame, amplitude_fits: pd.DataFrame, po
 # ============================================================================ power law
 @dataclass
 class PowerLawFit:
-    r""":math:`\sigma_{max} - \sigma_{min} = c\,(V^c - V)^\beta` (the Hopf scaling)."""
+    r""":math:`\sigma_{max} - \sigma_{min} = c\,(V^c - V)^\beta` (the Hopf scaling), from
+    :func:`fit_power_law`.
+
+    Attributes
+    ----------
+    exponent, exponent_err : float
+        :math:`\beta` and its standard error.
+    prefactor : float
+        :math:`c`.
+    Vc, Vc_err : float
+        The critical velocity used (given, error 0) or fitted, with its standard error.
+    Vc_fitted : bool
+        Whether V^c was a fitted parameter.
+    n_points : int
+        Points in the fit (amplitude > 0, finite).
+    rms_log : float
+        Root-mean-square residual of :math:`\ln(\sigma_{max} - \sigma_{min})`.
+    """
 
     exponent: float
     exponent_err: float
@@ -644,9 +835,38 @@ class PowerLawFit:
 def fit_power_law(V, amplitude, *, Vc: float | None = None) -> PowerLawFit:
     r"""Fit :math:`\ln(\sigma_{max}-\sigma_{min}) = \ln c + \beta\ln(V^c - V)`.
 
-    With ``Vc`` given the fit is linear (least squares in log-log).  Without it V^c is a
-    third parameter (bounded above the largest V), fitted by nonlinear least squares in
-    log space — the right choice when V^c is only known to a bisection bracket.
+    With ``Vc`` given the fit is linear (least squares in log-log, :func:`rsf.fit_power_law`).
+    Without it V^c is a third parameter (bounded above the largest V), fitted by nonlinear
+    least squares in log space — the right choice when V^c is only known to a bisection
+    bracket.
+
+    Parameters
+    ----------
+    V, amplitude : array_like
+        Velocities and stick-slip amplitudes, 1-D and of equal length; points that are not
+        finite or have amplitude <= 0 are dropped.
+    Vc : float, optional
+        The critical velocity, > every V; fitted if not given.
+
+    Returns
+    -------
+    PowerLawFit
+        Exponent, prefactor, V^c (given or fitted) with their errors, and the rms in log.
+
+    Raises
+    ------
+    ValueError
+        If ``V`` and ``amplitude`` are not 1-D of equal length, fewer than 3 usable points
+        remain (4 without ``Vc``), or ``Vc`` is not a finite number > every V.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from compare import fit_power_law
+    >>> V = 1.3 * (1.0 - np.geomspace(1e-3, 0.1, 6))
+    >>> fit = fit_power_law(V, 0.2 * (1.3 - V) ** 0.5, Vc=1.3)
+    >>> round(fit.exponent, 6), round(fit.prefactor, 6)
+    (0.5, 0.2)
     """
     V = np.asarray(V, dtype=float)
     amp = np.asarray(amplitude, dtype=float)
@@ -710,7 +930,27 @@ GROWTH_LAWS: dict[str, tuple[Callable, tuple[str, str], str]] = {
 
 @dataclass
 class GrowthFit:
-    """A two-parameter growth law fitted to peak-versus-hold data."""
+    """A two-parameter growth law fitted to peak-versus-hold data (:func:`fit_growth_law`).
+
+    Attributes
+    ----------
+    law : str
+        The law's name, a key of :data:`GROWTH_LAWS`.
+    formula : str
+        Its formula in the parameters' names.
+    names, values, errors : tuple of two
+        The parameters' names, fitted values and standard errors (nan if the fit failed).
+    rms : float
+        Root-mean-square residual in Δσ.
+    rel_rms : float
+        ``rms`` over the largest Δσ.
+    n_points : int
+        Points fitted.
+    success : bool
+        Whether the least squares converged (else ``values`` are the starting guess).
+    message : str
+        Why it did not.
+    """
 
     law: str
     formula: str
@@ -746,6 +986,35 @@ def fit_growth_law(hold_time, delta_sigma, law: str) -> GrowthFit:
 
     Points with hold time 0 are kept (every law is 0 there).  The fit is unweighted least
     squares in Δσ; ``rel_rms`` is the rms residual over the largest Δσ.
+
+    Parameters
+    ----------
+    hold_time, delta_sigma : array_like
+        Hold times (>= 0) and peak increases, 1-D of equal length; non-finite points and
+        negative hold times are dropped.
+    law : {'exponential', 'algebraic', 'logarithmic'}
+        The law to fit.
+
+    Returns
+    -------
+    GrowthFit
+        Its two parameters with errors and the residual; a fit that does not converge is
+        returned with ``success=False`` and its ``message``, not raised.
+
+    Raises
+    ------
+    ValueError
+        If ``law`` is unknown, the arrays are not 1-D of equal length, or fewer than 3
+        usable points remain.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from compare import fit_growth_law
+    >>> t = np.geomspace(0.1, 100.0, 10)
+    >>> g = fit_growth_law(t, 0.05 * (1.0 - np.exp(-t / 2.0)), "exponential")
+    >>> g.names, tuple(round(x, 6) for x in g.values)
+    (('d_inf', 'tau'), (0.05, 2.0))
     """
     law = choice("law", law, tuple(GROWTH_LAWS))
     t = np.asarray(hold_time, dtype=float)

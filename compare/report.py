@@ -71,7 +71,29 @@ _SLOWEST_FIRST = {"stationary": 0, "slide_hold_slide": 0, "trace": 1, "nblock": 
 @dataclass
 class Report:
     """What :func:`report` computed: tables (DataFrames, also written as CSV), figure paths,
-    the summary text, the run time and the runner's statistics."""
+    the summary text, the run time and the runner's statistics.
+
+    ``report[name]`` is the table ``name`` (a KeyError naming the tables if there is none).
+
+    Attributes
+    ----------
+    settings : Settings
+        The settings it ran with (its ``scenarios`` as selected).
+    tables : dict of str to pandas.DataFrame
+        Every table by name (micro's points, the fits, the RS curves, the settings).
+    figures : dict of str to pathlib.Path
+        The PNG figures written (empty without ``out``).
+    values : dict
+        The scalars the summary quotes (fitted constants, D_c, exponents, ...).
+    summary : str
+        The text of ``summary.md``.
+    out : pathlib.Path or None
+        The report folder, if one was written.
+    wall_time : float
+        Seconds the whole report took.
+    stats : RunStats
+        The runner's counts: points asked for, cached, computed, failed.
+    """
 
     settings: Settings
     tables: dict[str, pd.DataFrame] = field(default_factory=dict)
@@ -119,7 +141,33 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
         matching is still reported).
     cache_dir, use_cache : where micro records are cached (default: ``$COMPARE_CACHE_DIR`` or
         ``~/.cache/frictionkit-compare``), or no cache at all.
-    workers, scheduler, progress : see :class:`~compare.runner.Runner`.
+    workers : int, optional
+        Local worker processes (default: the cores this process may use; 1 runs in this
+        process); see :class:`~compare.runner.Runner`.
+    scheduler : str or distributed.Client, optional
+        A dask.distributed scheduler to run the micro tasks on instead.
+    progress : bool
+        Show progress bars (default True).
+
+    Returns
+    -------
+    Report
+        The tables, the figures' paths (with ``out``), the scalars and the summary text.
+
+    Raises
+    ------
+    ValueError
+        If ``settings`` is not a :class:`~compare.params.Settings`, ``scenarios`` names an
+        unknown scenario, ``Dc`` is not a finite number > 0, ``out`` cannot be written (a
+        file, a non-empty folder no report wrote, no write permission: checked before any
+        computation), ``cache_dir`` is a file, ``workers`` is not an integer >= 1 or
+        ``scheduler`` is neither an address nor a client (or dask is missing).
+
+    Examples
+    --------
+    >>> import compare
+    >>> rep = compare.report(compare.Settings.quick(), out="report")   # doctest: +SKIP
+    >>> print(rep.summary)                                               # doctest: +SKIP
     """
     start = time.perf_counter()
     settings = Settings.default() if settings is None else settings

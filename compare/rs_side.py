@@ -30,7 +30,45 @@ def rs_curves(k0s: Sequence[float], law_for: Callable[[float], rsf.SteadyStateLa
               options: rsf.SolverOptions | None = None, label: str = "") -> pd.DataFrame:
     """RS attractors on ``n`` log-spaced velocities per k0 (``V_range(k0)`` gives the ends).
 
-    Returns ``k0, V, regime, sigma_max, sigma_min, sigma_mean, converged, Dc, label``.
+    Where the critical velocity or the lower end of the unstable band falls inside the
+    range, velocities just beside it are added, so that the curves resolve the
+    bifurcation.
+
+    Parameters
+    ----------
+    k0s : sequence of float
+        Driving stiffnesses, > 0.
+    law_for : callable
+        k0 -> the RS steady-state law (an :class:`rsf.SteadyStateLaw`).
+    Dc : float
+        Critical slip distance, > 0.
+    V_range : callable
+        k0 -> (lowest, highest) velocity, both > 0.
+    n : int
+        Velocities per k0 before the additions (default 80).
+    options : rsf.SolverOptions, optional
+        For the limit cycles; default :data:`DEFAULT_OPTIONS`.
+    label : str
+        Written in the ``label`` column (which law or D_c the curves are for).
+
+    Returns
+    -------
+    DataFrame
+        ``k0, V, regime, sigma_max, sigma_min, sigma_mean, converged, Dc, label``, one row
+        per velocity.
+
+    Raises
+    ------
+    ValueError
+        If rsf refuses a parameter (a k0, Dc or velocity that is not a finite number > 0).
+
+    Examples
+    --------
+    >>> import rsf
+    >>> from compare import rs_curves
+    >>> curves = rs_curves([0.1], lambda k0: rsf.HyperbolicLaw(), 0.06, V_range=lambda k0: (0.5, 5.0), n=4)
+    >>> sorted(set(curves.regime))
+    ['steady', 'stick-slip']
     """
     options = options or DEFAULT_OPTIONS
     frames = []
@@ -56,7 +94,34 @@ def rs_curves(k0s: Sequence[float], law_for: Callable[[float], rsf.SteadyStateLa
 def rs_hopf(model: rsf.SpringSlider, distances: Sequence[float], *,
             options: rsf.SolverOptions | None = None) -> pd.DataFrame:
     """Limit cycles at :math:`V = V^c (1 - d)`; columns ``d, V, Vc, amplitude, sigma_max,
-    sigma_min, regime, converged``."""
+    sigma_min, regime, converged``.
+
+    Parameters
+    ----------
+    model : rsf.SpringSlider
+        The RS model; it must have a finite critical velocity.
+    distances : sequence of float
+        Relative distances d below V^c, each in (0, 1).
+    options : rsf.SolverOptions, optional
+        Default ``cycle_rtol=1e-10, rtol=1e-11, atol=1e-13`` (small amplitudes near V^c).
+
+    Returns
+    -------
+    DataFrame
+        One row per distance, with the columns above.
+
+    Raises
+    ------
+    ValueError
+        If the model has no finite critical velocity or a distance lies outside (0, 1).
+
+    Examples
+    --------
+    >>> import rsf
+    >>> from compare import rs_hopf
+    >>> rs_hopf(rsf.SpringSlider(k0=0.1), [0.01]).regime.tolist()
+    ['stick-slip']
+    """
     cv = rsf.critical_velocity(model)
     if not (math.isfinite(cv.Vc) and cv.Vc > 0):
         raise ValueError(f"no finite RS critical velocity for k0 = {model.k0!r}, Dc = {model.Dc!r}")
@@ -80,8 +145,37 @@ def rs_slide_hold_slide(model: rsf.SpringSlider, V: float, hold_times: Sequence[
 
     For each hold: slide for :math:`D_c/V` from the exact steady state, stop the drive for
     the hold, reload at V; the peak is the largest σ after the reload starts (a stick end
-    on the threshold for a = 0, the σ-maximum event for a > 0).  Returns ``hold_time,
-    sigma_steady, sigma_peak, delta_sigma_max, status`` per hold.
+    on the threshold for a = 0, the σ-maximum event for a > 0).
+
+    Parameters
+    ----------
+    model : rsf.SpringSlider
+        Any RS model (Eq. 11 with a = 0, or a direct effect a > 0).
+    V : float
+        The sliding velocity before and after the hold, > 0.
+    hold_times : sequence of float
+        Hold durations, each > 0.
+    options : rsf.SolverOptions, optional
+        Default ``rtol=1e-9``.
+
+    Returns
+    -------
+    DataFrame
+        ``hold_time, sigma_steady, sigma_peak, delta_sigma_max, status`` per hold (a run
+        that fails keeps its negative rsf status; its peak is what it reached).
+
+    Raises
+    ------
+    ValueError
+        If ``V`` or a hold time is not a finite number > 0.
+
+    Examples
+    --------
+    >>> import rsf
+    >>> from compare import rs_slide_hold_slide
+    >>> shs = rs_slide_hold_slide(rsf.SpringSlider(k0=0.1), 1.0, [1.0, 10.0])
+    >>> bool(shs.delta_sigma_max.iloc[1] > shs.delta_sigma_max.iloc[0] > 0)
+    True
     """
     V = positive("V", V)
     options = options or rsf.SolverOptions(rtol=1e-9)
@@ -120,6 +214,38 @@ def classical_rs(law: rsf.SteadyStateLaw, V: float, b: float, k0: float, Dc: flo
 
     so that its steady friction and its velocity weakening at V equal those of ``law``;
     ``b`` (> W(V)) is the one free constant.
+
+    Parameters
+    ----------
+    law : rsf.SteadyStateLaw
+        The steady law to be tangent to, with every parameter set (a
+        :class:`rsf.HyperbolicLaw` with its ``mu_inf``, or bound to a k0).
+    V : float
+        The velocity of tangency and the log law's reference velocity, > 0.
+    b : float
+        The evolution effect, > W(V).
+    k0, Dc : float
+        Stiffness and critical slip distance of the spring-slider, > 0.
+
+    Returns
+    -------
+    rsf.SpringSlider
+        With ``LogLaw(mu0=law.mu_ss(V), a=b - W(V), b=b, v0=V)`` and the direct effect
+        ``a``.
+
+    Raises
+    ------
+    ValueError
+        If ``V``, ``b``, ``k0`` or ``Dc`` is not a finite number > 0, ``b <= W(V)``, or the
+        law still depends on k0 (its ``mu_inf`` unset).
+
+    Examples
+    --------
+    >>> import rsf
+    >>> from compare import classical_rs
+    >>> model = classical_rs(rsf.HyperbolicLaw().bind(0.1), V=1.0, b=0.02, k0=0.1, Dc=0.06)
+    >>> round(model.law.b - model.law.a, 6), round(model.sigma_steady(1.0), 6)
+    (0.006024, 0.951494)
     """
     V, b = positive("V", V), positive("b", b)
     W = float(law.weakening(np.array([V]))[0])

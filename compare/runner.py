@@ -46,7 +46,25 @@ log = logging.getLogger(__name__)
 @dataclass
 class RunStats:
     """What a runner did: tasks asked for, served from the cache, computed, failed, and the
-    summed compute time of the computed ones."""
+    summed compute time of the computed ones.
+
+    Attributes
+    ----------
+    requested : int
+        Distinct tasks asked for.
+    cached : int
+        Of them, served from the cache.
+    computed : int
+        Computed (each written to the cache as it arrived).
+    failed : int
+        Computed with a status other than ``'ok'``.
+    compute_seconds : float
+        Summed wall time of the computed tasks (over all workers).
+    warm_up_seconds : float
+        Time spent compiling micro's kernels before the pool started.
+    slowest : list of (float, str)
+        The five slowest computed tasks: (seconds, label), slowest first.
+    """
 
     requested: int = 0
     cached: int = 0
@@ -142,7 +160,25 @@ class Runner:
     progress : bool
         Show a progress bar.
 
+    Raises
+    ------
+    ValueError
+        If ``cache`` is not a cache, ``workers`` is not an integer >= 1, or ``scheduler``
+        is neither an address nor a client, or is an address without dask.distributed
+        installed.
+
+    Notes
+    -----
     Use it as a context manager (or call :meth:`close`) to shut the pool down.
+
+    Examples
+    --------
+    >>> import micro
+    >>> from compare import NullCache, Runner, SteadyTask
+    >>> with Runner(NullCache(), workers=1, progress=False) as runner:
+    ...     [record] = runner.run([SteadyTask(micro.Model(k0=0.1), (0.5, 2.0))])
+    >>> record["status"]
+    'ok'
     """
 
     def __init__(self, cache: PointCache | NullCache | None = None, *, workers: int | None = None,
