@@ -67,6 +67,12 @@ class JumpDistribution:
     Subclasses provide the cumulative distribution, its first two moments, a quantile
     function for sampling and a support bound.  ``kind`` is the integer code the numba
     kernels dispatch on.
+
+    Not used directly: :class:`Model` takes one of its subclasses as ``jumps``.
+
+    See Also
+    --------
+    Exponential, Deterministic, Tabulated
     """
 
     kind: int
@@ -110,6 +116,27 @@ class Exponential(JumpDistribution):
 
     The paper (Appendix B) uses the cutoff :math:`z_c = 10`; the normalisation
     :math:`1 - e^{-z_c/\bar z}` is kept so that g is a probability density for any cutoff.
+
+    Parameters
+    ----------
+    zbar : float
+        The mean of the exponential before the cutoff, > 0 (default 0.1); the
+        distribution's ``mean`` is below it by the cut tail (equal to double precision
+        for the default cutoff).
+    cutoff : float
+        Largest distance :math:`z_c`, finite and > ``zbar`` (default 10).
+
+    Raises
+    ------
+    ValueError
+        If ``zbar`` is not a finite number > 0, or ``cutoff`` is not finite and > ``zbar``.
+
+    Examples
+    --------
+    >>> from micro import Exponential
+    >>> g = Exponential(0.1)
+    >>> round(g.mean, 12), round(g.mean_residual, 12)     # <z^2> / (2 <z>) = zbar
+    (0.1, 0.1)
     """
 
     zbar: float = 0.1
@@ -154,7 +181,18 @@ class Exponential(JumpDistribution):
 
 @dataclass(frozen=True)
 class Deterministic(JumpDistribution):
-    r"""All pinning wells at the same distance: :math:`g(z) = \delta(z - \bar z)`."""
+    r"""All pinning wells at the same distance: :math:`g(z) = \delta(z - \bar z)`.
+
+    Parameters
+    ----------
+    zbar : float
+        The distance, > 0 (default 0.1).
+
+    Raises
+    ------
+    ValueError
+        If ``zbar`` is not a finite number > 0.
+    """
 
     zbar: float = 0.1
     kind: int = field(default=KIND_DETERMINISTIC, init=False, repr=False)
@@ -187,6 +225,31 @@ class Tabulated(JumpDistribution):
 
     The density is tabulated on ``n`` points, normalised, and its cumulative distribution
     and quantile function are built by the trapezoidal rule; ``zbar`` is its mean.
+
+    Parameters
+    ----------
+    pdf : callable
+        ``pdf(z) -> g(z)`` for an array ``z`` (vectorised), finite and >= 0 on
+        ``[0, support_max]``; it need not be normalised.
+    support_max : float
+        Upper end of the support, > 0 (default 1).
+    n : int
+        Tabulation points, >= 17 (default 4097).
+
+    Raises
+    ------
+    ValueError
+        If ``pdf`` is not callable, returns an array of another shape, a negative or
+        non-finite value, or no mass; ``support_max`` is not a finite number > 0; or
+        ``n`` < 17.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from micro import Tabulated
+    >>> g = Tabulated(lambda z: z * np.exp(-z / 0.05))    # a gamma density, mean 0.1
+    >>> round(g.zbar, 5)
+    0.1
     """
 
     pdf: Callable[[np.ndarray], np.ndarray] = field(repr=False, default=None)  # type: ignore[assignment]
@@ -251,13 +314,33 @@ class Model:
 
     Parameters
     ----------
-    k0 : driving-spring stiffness, in (0, 1e3 f_th / zbar] (1e4 for the paper's parameters).
-    k1 : elastic coupling between blocks, in [0, 1e3 f_th / zbar].
-    k2 : stiffness of the viscoelastic (spring + dashpot) coupling, in [0, 1e3 f_th / zbar].
-    eta_u : dashpot viscosity, > 0; the relaxation rate is ``gamma = k2 / eta_u``.
-    f_th : pinning threshold, > 0.
-    jumps : distribution of pinning distances; default exponential with mean 0.1 and
-        cutoff 10 (the paper's Fig. 4 parameters).
+    k0 : float
+        Driving-spring stiffness, in (0, 1e3 f_th / zbar] (1e4 for the paper's parameters).
+    k1 : float
+        Elastic coupling between blocks, in [0, 1e3 f_th / zbar] (default 0.1).
+    k2 : float
+        Stiffness of the viscoelastic (spring + dashpot) coupling, in [0, 1e3 f_th / zbar]
+        (default 0.9).
+    eta_u : float
+        Dashpot viscosity, > 0 (default 1); the relaxation rate is ``gamma = k2 / eta_u``.
+    f_th : float
+        Pinning threshold, > 0 (default 1).
+    jumps : JumpDistribution
+        Distribution of pinning distances; default exponential with mean 0.1 and cutoff 10
+        (the paper's Fig. 4 parameters).
+
+    Raises
+    ------
+    ValueError
+        If ``jumps`` is not a :class:`JumpDistribution`, or a constant is not a number (a
+        bool or a string is refused) or lies outside its range.
+
+    Examples
+    --------
+    >>> import micro
+    >>> model = micro.Model(k0=0.1)
+    >>> round(model.kappa, 12), model.gamma, round(model.zbar, 12)
+    (1.1, 0.9, 0.1)
     """
 
     k0: float

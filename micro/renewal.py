@@ -350,6 +350,36 @@ def characteristic_function(model: Model, V: float, lam, *, tol: float = 1e-10) 
     :math:`e^{\lambda t}` where :math:`G(\lambda) = 1`.  ``lam`` is in units of 1/time
     (real or complex, an array or a number; ``Re lam > -gamma``, not 0).  Limits:
     :math:`G(0^+) = k_1/(k_0+k_1)`, :math:`G(+\infty) = b`, the branching ratio.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    V : float
+        Drive velocity, in [1e-6, 1e7].
+    lam : complex or array_like
+        Where to evaluate G, in 1/time.
+    tol : float
+        Tolerance of the chain's adaptive grid (default 1e-10).
+
+    Returns
+    -------
+    ndarray of complex
+        :math:`G(\lambda)`, with the shape of ``lam``.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`Model`, ``V`` is out of range, or a ``lam`` is 0, not
+        finite or has :math:`\operatorname{Re}\lambda \le -\gamma`.
+
+    Examples
+    --------
+    >>> import micro
+    >>> model = micro.Model(k0=0.1)
+    >>> G = micro.characteristic_function(model, 2.0, [1e6])          # G(+inf) = b
+    >>> round(float(G[0].real), 4), round(float(micro.steady_sliding(model, 2.0).branching_ratio), 4)
+    (0.9423, 0.9423)
     """
     _check_model(model)
     V = float(_check_velocities(V))
@@ -395,7 +425,41 @@ def unstable_mode_count(model: Model, V: float, *, omega_max: float | None = Non
     r"""The number of roots of :math:`G(\lambda) = 1` with :math:`\operatorname{Re}\lambda > 0`,
     by the argument principle along the imaginary axis (G is analytic in the right
     half-plane and tends to b on its large half-circle).  A check of the claim that b
-    alone decides stability; it costs ``n_omega`` evaluations of G."""
+    alone decides stability; it costs ``n_omega`` evaluations of G.  Where the phase has
+    not settled (close to V^c, where G(iω) − 1 tends to b − 1 only beyond the frequencies
+    the quadrature resolves) a warning is logged and the count is not conclusive.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    V : float
+        Drive velocity, in [1e-6, 1e7].
+    omega_max : float, optional
+        The largest frequency on the axis, > 0 (default ``200 V / zbar``).
+    n_omega : int
+        Frequencies, geometric from ``1e-6 gamma`` to ``omega_max`` (an integer >= 10,
+        default 4000).
+    tol : float
+        Tolerance of the chain's adaptive grid (default 1e-10).
+
+    Returns
+    -------
+    int
+        The number of unstable modes (0 where steady sliding is stable).
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`Model`, ``V`` is out of range, ``n_omega`` is not an
+        integer >= 10, or ``omega_max`` is not a finite number > 0.
+
+    Examples
+    --------
+    >>> import micro
+    >>> micro.unstable_mode_count(micro.Model(k0=0.3), 0.06)      # below V^c = 0.1947; seconds
+    1
+    """
     _check_model(model)
     V = float(_check_velocities(V))
     if int(n_omega) != n_omega or n_omega < 10:
@@ -421,12 +485,32 @@ def unstable_mode_count(model: Model, V: float, *, omega_max: float | None = Non
 class SteadySliding:
     """Steady sliding at each drive velocity, from the renewal chain.
 
-    Arrays have the shape of the ``V`` given.  ``sigma`` is the stationary stress,
-    ``branching_ratio`` the mean number of blocks a jump pushes over the threshold,
-    ``stable`` whether steady sliding is linearly stable (b < 1), ``growth_rate`` the rate
-    of the unstable mode (1/time; NaN where stable or not asked for), ``sigma_error`` and
-    ``branching_error`` the change from the previous grid, ``wait_error`` the relative
-    error of the mean waiting time against zbar / V, ``n_nodes`` the grid used.
+    Arrays have the shape of the ``V`` given; ``to_frame()`` has one row per V.
+
+    Attributes
+    ----------
+    model : Model
+        The model.
+    V : ndarray
+        The drive velocities.
+    sigma : ndarray
+        The stationary stress.
+    branching_ratio : ndarray
+        b, the mean number of blocks a jump pushes over the threshold.
+    stable : ndarray of bool
+        Whether steady sliding is linearly stable (b < 1).
+    growth_rate : ndarray
+        The rate of the unstable mode (1/time; NaN where stable or not asked for).
+    sigma_error, branching_error : ndarray
+        The change of sigma and b from the previous grid.
+    wait_error : ndarray
+        The relative error of the mean waiting time against zbar / V.
+    n_nodes : ndarray of int
+        The grid used (0 without dashpot, 1 for deterministic jumps: closed forms).
+    converged : ndarray of bool
+        Whether the grid met ``tol``.
+    message : str
+        ``'converged'``, or the velocities where it did not.
     """
 
     model: Model
@@ -478,6 +562,38 @@ def steady_sliding(model: Model, V, *, tol: float = 1e-11, growth_rate: bool = T
     compilation; with ``growth_rate`` (the default) each unstable V also costs a root
     search on G (about 0.03 s).  A grid that misses ``tol`` is logged as a warning unless
     ``warn`` is False; ``converged`` and ``message`` say it either way.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    V : float or array_like
+        Drive velocities, each in [1e-6, 1e7] (and at most ``gamma zbar / 1e-16``).
+    tol : float
+        Change of sigma and b between grids at which to stop, > 0 (default 1e-11).
+    growth_rate : bool
+        Compute the growth rate of the unstable mode where b > 1 (default True).
+    warn : bool
+        Log a warning where the grid misses ``tol`` (default True).
+
+    Returns
+    -------
+    SteadySliding
+        sigma, the branching ratio, stability and growth rate at each V, with their
+        errors.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`Model`, a velocity is not finite or out of range,
+        or ``tol`` is not a finite number > 0.
+
+    Examples
+    --------
+    >>> import micro
+    >>> branch = micro.steady_sliding(micro.Model(k0=0.1), [0.5, 2.0])
+    >>> branch.stable.tolist(), [round(float(s), 6) for s in branch.sigma]
+    ([False, True], [0.902686, 0.893759])
     """
     _check_model(model)
     v = _check_velocities(V)
@@ -527,7 +643,30 @@ def vc_small_k0(model: Model) -> float:
     r"""The small-k0 asymptote of the critical velocity,
     :math:`V^c \simeq k_2 \gamma \langle z^2\rangle / (2 \bar z k_0)`: at large V the
     stationary spring stretch at a jump averages the mean residual
-    :math:`\langle z^2\rangle/(2\bar z)`, and b = 1 where ``k2 E[1 - x] = k0``."""
+    :math:`\langle z^2\rangle/(2\bar z)`, and b = 1 where ``k2 E[1 - x] = k0``.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+
+    Returns
+    -------
+    float
+        The asymptote; the exact V^c (:func:`micro.critical_velocity`) approaches it as
+        :math:`1 - O(k_0)`.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`Model`.
+
+    Examples
+    --------
+    >>> import micro
+    >>> round(micro.vc_small_k0(micro.Model(k0=0.01)), 6)      # 0.081 / k0
+    8.1
+    """
     _check_model(model)
     return model.k2 * model.gamma * model.jumps.mean_residual / model.k0
 
@@ -538,7 +677,32 @@ def critical_velocity_renewal(model: Model, *, V_min: float = 1e-4, V_max: float
     """V^c as the root of ``b(V) = 1``, the velocity where the branching ratio of steady
     sliding crosses 1 (Brent's method on log V).  ``k0 >= k2`` (or ``k2 = 0``): steady
     sliding is stable at every V (b < 1 already at V -> 0), Vc = 0 at once.
-    Returns ``(Vc, error, status, message, evaluations)``."""
+    :func:`micro.critical_velocity` calls it and wraps the result.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    V_min, V_max : float
+        The range searched (default 1e-4 to 1e5), bracketing outward from
+        :func:`vc_small_k0`.
+    rtol : float
+        Relative tolerance of the root (default 1e-10).
+    tol : float
+        Tolerance of each :func:`steady_sliding` (default 1e-11).
+
+    Returns
+    -------
+    tuple
+        ``(Vc, error, status, message, evaluations)``: status ``'converged'``, ``'no
+        stick-slip'`` (Vc = 0) or ``'above range'`` (Vc = inf); ``evaluations`` is a
+        list of dicts ``V, branching_ratio, error``.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`Model`.
+    """
     _check_model(model)
     evaluations: list[dict] = []
     if model.k2 == 0.0 or model.k0 >= model.k2:
