@@ -197,7 +197,17 @@ def _residual_quantile(dist: JumpDistribution, q: np.ndarray, n_grid: int = 200_
 # ---------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class NBlockState:
-    """Positions ``h``, dashpot elongations ``u`` and drive position ``w`` at time ``t``."""
+    """Positions ``h``, dashpot elongations ``u`` and drive position ``w`` at time ``t``.
+
+    Parameters
+    ----------
+    h, u : ndarray
+        The blocks' positions and dashpot elongations, one per block.
+    w : float
+        The drive's position.
+    t : float
+        The time (:func:`simulate_nblock` starts every run at 0 and ignores it).
+    """
 
     h: np.ndarray
     u: np.ndarray
@@ -247,6 +257,30 @@ def initial_state(
     evenly spaced phases, the steady state of Appendix C); ``phases="random"`` draws them
     independently (seeded by ``seed``). Both have :math:`\langle u_i\rangle = 0`.
     The paper notes that the initial condition only affects transients.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    n_blocks : int
+        N, an integer in [2, 2**27].
+    kind : {'relaxed', 'frozen'}
+        As above.
+    phases : {'stratified', 'random'}
+        As above.
+    seed : int
+        Seed of the random phases, in [0, 2**63 - 1].
+
+    Returns
+    -------
+    NBlockState
+        At t = 0.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`~micro.params.Model`, ``n_blocks`` or ``seed`` is out
+        of range, or ``kind`` or ``phases`` is not one of its choices.
     """
     _check_model(model)
     n = _check_int("n_blocks", n_blocks, 2, MAX_BLOCKS)
@@ -369,6 +403,26 @@ def simulate_nblock(
     Returns
     -------
     NBlockResult
+        The binned time series, the global shocks, the final state and the counts; a run
+        stopped by ``stop_after_shocks`` or ``max_jumps`` says so in ``status``.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`~micro.params.Model`, ``n_blocks`` is not an integer
+        in [2, 2**27], a velocity is negative or not finite, a constant velocity comes
+        without ``t_max``, a schedule entry is not a (duration > 0, velocity >= 0) pair,
+        ``record_every`` makes more than 5e7 bins, ``shock_fraction`` is not > 0, a count
+        is not a positive integer, or ``initial`` is neither a kind nor an
+        :class:`NBlockState` of N finite blocks.
+
+    Examples
+    --------
+    >>> import micro
+    >>> from micro import nblock as nb
+    >>> run = nb.simulate_nblock(micro.Model(k0=0.1), 2.0, 2000, t_max=5.0, record_every=0.5)
+    >>> run.status, len(run.to_frame())
+    ('completed', 10)
 
     Notes
     -----
@@ -513,6 +567,35 @@ class StationaryStress:
     correction) when the lag-1 autocorrelation :math:`\rho` of the batch means is positive.
     A large :math:`\rho` means the batches are too short. ``regime`` is ``"stick-slip"`` if global
     shocks occurred during the measurement (the mean is then not a stationary stress).
+
+    Attributes
+    ----------
+    sigma_mean, sigma_stderr, sigma_stderr_naive : float
+        As above.
+    batch_means : ndarray
+        The exact time average of sigma over each batch (``n_batches`` is their number).
+    batch_length, t_transient : float
+        The batches' length and the time discarded before them (a whole number of
+        batches).
+    lag1_autocorrelation : float
+        :math:`\rho`.
+    n_global_shocks : int
+        Global shocks during the measurement.
+    regime : str
+        ``'steady'`` or ``'stick-slip'`` (two shocks or more).
+    status : str
+        ``'ok'``, ``'stick-slip'`` or ``'correlated'`` (:math:`\rho > 0.3`); ``message``
+        says why.
+    message : str
+        Human-readable status.
+    velocity : float
+        The drive velocity.
+    n_blocks : int
+        N.
+    wall_time : float
+        Seconds the run took.
+    result : NBlockResult
+        The whole run.
     """
 
     sigma_mean: float
@@ -597,6 +680,23 @@ def stationary_stress_nblock(
     Returns
     -------
     StationaryStress
+        The mean, its standard errors, the batch means and the regime seen.
+
+    Raises
+    ------
+    ValueError
+        If an argument is refused (as by :func:`simulate_nblock`; ``velocity`` must be
+        > 0, ``batch_length`` > 0, ``t_transient`` >= 0, ``n_batches`` an integer >= 2).
+    RuntimeError
+        If the run stopped before its end (``max_jumps``).
+
+    Examples
+    --------
+    >>> import micro
+    >>> from micro import nblock as nb
+    >>> st = nb.stationary_stress_nblock(micro.Model(k0=0.1), 2.0, 20_000, t_transient=5.0, batch_length=1.0)
+    >>> st.regime, round(st.sigma_mean, 3)         # at N = 2000 finite-size avalanches read as shocks
+    ('steady', 0.894)
     """
     _check_model(model)
     v = _check_float("velocity", velocity, low=0.0, strict=True)
@@ -663,6 +763,32 @@ class StickSlipExtrema:
     the first and second halves of the cycles differ by more than three standard errors:
     the cycle was still converging, so ``n_discard`` was too small (the cycle map contracts
     by about 0.96 per cycle at k0 = 0.01, 0.9 V^c: hundreds of cycles).
+
+    Attributes
+    ----------
+    sigma_max, sigma_max_stderr, sigma_min, sigma_min_stderr : float
+        The means and their standard errors (NaN without cycles).
+    period, period_stderr : float
+        Mean time between the shocks and its standard error.
+    n_cycles : int
+        Shocks averaged over.
+    regime : str
+        ``'stick-slip'`` or ``'steady'`` (too few shocks).
+    status : str
+        ``'ok'``, ``'transient'``, ``'fewer_cycles'`` (the run ended with fewer than
+        ``n_cycles`` shocks after the discarded ones) or ``'no_cycles'``.
+    message : str
+        Human-readable status.
+    velocity : float
+        The drive velocity.
+    n_blocks : int
+        N.
+    wall_time : float
+        Seconds the run took.
+    shocks : pandas.DataFrame
+        The shocks averaged over (``t, sigma_before, sigma_after, size, delta_hbar``).
+    result : NBlockResult
+        The whole run.
     """
 
     sigma_max: float
@@ -703,6 +829,39 @@ def stick_slip_extrema_nblock(
     ``shock_fraction * N`` jumps) have occurred, or until ``t_max`` (default
     ``(n_discard + n_cycles + 1) * 2 f_th / (k0 V)``, twice the time the drive needs to load
     the stress by f_th per cycle). The first ``n_discard`` shocks are the transient.
+
+    Parameters
+    ----------
+    model, n_blocks, seed, initial, phases, shock_fraction, record_every, max_jumps :
+        As in :func:`simulate_nblock` (``record_every`` defaults to ``t_max / 2000``).
+    velocity : float
+        The drive velocity, > 0.
+    n_cycles : int
+        Shocks to average over, an integer in [2, 1e6] (default 20).
+    n_discard : int
+        Shocks discarded first, in [0, 1e6] (default 10).
+    t_max : float, optional
+        The longest run, > 0 (default as above).
+
+    Returns
+    -------
+    StickSlipExtrema
+        The means with their standard errors, the period and the status
+        (``'transient'`` when the cycles still drift).
+
+    Raises
+    ------
+    ValueError
+        If an argument is refused (as by :func:`simulate_nblock`; ``velocity`` must be
+        > 0).
+
+    Examples
+    --------
+    >>> import micro
+    >>> from micro import nblock as nb
+    >>> cycle = nb.stick_slip_extrema_nblock(micro.Model(k0=0.1), 0.05, 2000, n_cycles=5, n_discard=3)
+    >>> cycle.regime, bool(cycle.sigma_max > cycle.sigma_min)
+    ('stick-slip', True)
     """
     _check_model(model)
     v = _check_float("velocity", velocity, low=0.0, strict=True)
@@ -779,6 +938,34 @@ def sigma_deterministic_steady_finite_n(model: Model, velocity: float, n_blocks:
         \langle\sigma\rangle &= \sigma_b - \frac{k_0 \bar z}{2N},
 
     which tends to Eq. (4) as :math:`N \to \infty`. Derived in ``docs/reference/micro_nblock.md``.
+
+    Parameters
+    ----------
+    model : Model
+        The model (its ``jumps`` taken as deterministic, at their mean).
+    velocity : float
+        The drive velocity, > 0.
+    n_blocks : int
+        N, an integer >= 2.
+
+    Returns
+    -------
+    float
+        :math:`\langle\sigma\rangle`.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`~micro.params.Model`, ``velocity`` is not a finite
+        number > 0 or ``n_blocks`` is not an integer >= 2.
+
+    Examples
+    --------
+    >>> import micro
+    >>> from micro import nblock as nb
+    >>> model = micro.Model(k0=1.0, jumps=micro.Deterministic(0.1))
+    >>> round(nb.sigma_deterministic_steady_finite_n(model, 0.5, 1000) - nb.sigma_deterministic_steady(model, 0.5), 8)
+    5e-05
     """
     _check_model(model)
     v = _check_float("velocity", velocity, low=0.0, strict=True)
