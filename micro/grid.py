@@ -25,7 +25,14 @@ TAIL_MASS = 1e-12
 
 class GridTooLarge(MemoryError):
     """The density's support outgrew the memory allowed for the grid
-    (``Numerics.max_memory_gib``)."""
+    (``Numerics.max_memory_gib``).
+
+    Raised by the Fokker-Planck solver (``method="fp"`` of :func:`micro.simulate`,
+    :func:`micro.stationary` and the functions built on them) before it allocates the grid;
+    a :class:`MemoryError`.  Its message gives the grid's size, k0, eps and the time, and
+    the ways out: a coarser ``eps``, a larger ``max_memory_gib``, or the N-block solver.
+    It takes the message as its one argument.
+    """
 
 
 @dataclass(frozen=True)
