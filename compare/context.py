@@ -245,15 +245,15 @@ class Context:
 
     def cycle_task(self, k0: float, V: float) -> StationaryTask:
         """Micro's stick-slip cycle at V by ``cycle_method``: ``"auto"``, micro's default
-        (the cohort method at its default step and cell, its fixed point to ``cycle_rtol``
-        of the velocity weakening), or the FP at ``eps``."""
+        (the cohort method at the step ``cycle_dt`` and its default cell, its fixed point to
+        ``cycle_rtol`` of the velocity weakening), or the FP at ``eps``."""
         s = self.s
         if s.cycle_method == "fp":
             return self.stationary_task(k0, V, s.eps, "fp")
         model = self.model(k0)
         tol = s.cycle_rtol * (model.f_th - micro.sigma_fast_limit(model))
         return StationaryTask(model, V, s.numerics(), s.convergence(), "auto",
-                              cohort=micro.Cohort(tol=min(max(tol, 1e-9), 1e-2)))
+                              cohort=micro.Cohort(dt=s.cycle_dt, tol=min(max(tol, 1e-9), 1e-2)))
 
     def cycle_tasks(self, pairs) -> list[StationaryTask]:
         """The cycles at ``pairs`` (k0, V / V^c), where k0 has stick-slip."""

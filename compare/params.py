@@ -62,8 +62,8 @@ class Settings:
     diagram and in the transition study are limit cycles solved by ``cycle_method``:
     ``"cohort"`` (the default, micro's own default for cycles, :mod:`micro.cohort`: no grid
     in the margin, the fixed point of the cycle map to ``cycle_rtol`` times the velocity
-    weakening ``f_th - sigma_fast_limit``, about 1e-4 in stress, each row with its
-    discretisation error where it is known) or ``"fp"`` (the Fokker-Planck equation at the
+    weakening ``f_th - sigma_fast_limit``, about 1e-4 in stress, at the time step
+    ``cycle_dt``, each row with its discretisation error where it is known) or ``"fp"`` (the Fokker-Planck equation at the
     bin ``eps``, whose cycles are off by about 1e-3 at eps = 0.016).  The transition study
     also runs the N-block simulation.  Slide-hold-slide and the traces time-step the
     Fokker-Planck equation at ``eps`` with the stopping rule ``rtol``, ``atol``, ``t_max``
@@ -88,6 +88,11 @@ class Settings:
     shown_points : (k0, V / V^c) of stick-slip points drawn on the diagram (by
         ``cycle_method``) but not matched by the fit (none by default).
     cycle_method, cycle_rtol : how the stick-slip points are solved (above).
+    cycle_dt : the cohort method's time step for the report's cycles (its cell is micro's
+        default, ``kappa zbar / 20``).  0.02, twice micro's default: the extrema move by
+        1e-5 to 2e-5 from dt = 0.02 to 0.01 at k0 = 0.3 to 1e-3, 0.4 V^c (as much as
+        halving the cell moves them), far below what the D_c fit resolves, for a third of
+        the cost (docs/validation/micro_defaults.md, "The report's time step").
     dc_bounds, dc_grid, bootstrap : D_c search range, scan resolution, bootstrap samples.
     hopf_k0 : k0 of the transition study; ``hopf_distances``: d = (V^c - V)/V^c of its
         cycles (by ``cycle_method``); ``nblock_N``, ``nblock_distances``: the
@@ -127,6 +132,7 @@ class Settings:
     shown_points: tuple[tuple[float, float], ...] = ()
     cycle_method: str = "cohort"
     cycle_rtol: float = 1e-3
+    cycle_dt: float = 0.02
     steady_ratios: tuple[float, ...] = (1.5, 3.0)
     dc_bounds: tuple[float, float] = (0.005, 0.5)
     dc_grid: int = 41
@@ -178,6 +184,7 @@ class Settings:
         set_("shown_points", _stick_slip_points("shown_points", self.shown_points))
         set_("cycle_method", choice("cycle_method", self.cycle_method, ("cohort", "fp")))
         set_("cycle_rtol", in_range("cycle_rtol", self.cycle_rtol, 1e-6, 0.1))
+        set_("cycle_dt", in_range("cycle_dt", self.cycle_dt, 0.0, 0.1, low_open=True))
         set_("steady_ratios", tuple(sorted(positive_array("steady_ratios", self.steady_ratios, low=1.0, high=1e4,
                                                           min_size=0))))
         lo, hi = (positive(f"dc_bounds[{i}]", v) for i, v in enumerate(self.dc_bounds))

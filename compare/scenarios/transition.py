@@ -15,7 +15,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-import micro
 import rsf
 from micro.api import NEAR_VC
 
@@ -141,11 +140,6 @@ def draw(ctx: Context, part: Part, out) -> dict[str, Path]:
     return {"hopf": figures.hopf(t, v, figures.target(out, "hopf.png"))}
 
 
-def _cohort_dt() -> str:
-    """The cohort method's time step of the report's cycles."""
-    return f"{micro.Cohort().dt:g}"
-
-
 def summary(ctx: Context, part: Part) -> list[str]:
     s, t, v = ctx.s, part.tables, part.values
     lines = [f"## The transition at k0 = {s.hopf_k0:g}", "",
@@ -154,7 +148,7 @@ def summary(ctx: Context, part: Part) -> list[str]:
     for _, r in t["hopf_fit"].iterrows():
         res = "" if not math.isfinite(r.resolution) else (
             f"N = {r.resolution:.0f}" if r.method == "N-block" else
-            f"h = {r.resolution:.3g}, dt = {_cohort_dt()}" if r.method == "cohort" else f"eps = {r.resolution:g}")
+            f"h = {r.resolution:.3g}, dt = {s.cycle_dt:g}" if r.method == "cohort" else f"eps = {r.resolution:g}")
         lines.append(f"| {r.model} | {r.method} | {res} | {fmt(r.exponent, 3)} | {fmt(r.exponent_err, 2)} | "
                      f"{int(r.n_points)} |")
     tr = v.get("transition", {})
