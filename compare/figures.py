@@ -19,6 +19,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from micro.api import NEAR_VC  # noqa: E402
+
 from . import fits  # noqa: E402
 
 __all__ = ["target"]
@@ -195,44 +197,91 @@ def critical_velocity(t: dict[str, pd.DataFrame], values: dict[str, Any], path: 
 
 
 def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
-    """The transition: micro's growth rate against d, and both models' amplitude against
-    d = (V^c - V)/V^c (each with its own exact V^c)."""
+    """The transition on both sides.  Left: the one test, the growth rate of the unstable
+    mode of steady sliding against d = (V^c - V)/V^c (micro's, and RS's at a = 0 where
+    ``rs_spectrum`` is given).  Right: both models' amplitude sigma_max - sigma_min
+    against d, log-log, each against its own exact V^c: the points with their error bars
+    (filled: the error is known and the point is fitted; open: not known, not fitted),
+    each method's fitted law over the d it rests on with its interval, and RS's derived
+    asymptote c0 d^(1/2) (1 + c2 d) (``values['rs_amplitude_law']``); micro has none
+    derived, and the figure says so."""
     pts, fit, spec = t["hopf_points"], t["hopf_fit"], t["micro_spectrum"]
-    fig, axes = plt.subplots(1, 2, figsize=(11.5, 4.5))
+    k0 = float(pts.k0.iloc[0]) if len(pts) else math.nan
+    fig, axes = plt.subplots(1, 2, figsize=(13.5, 5.4), gridspec_kw={"width_ratios": [1, 1.45]})
     ax = axes[0]
-    sp = spec[np.isfinite(spec.growth_rate)]
-    ax.loglog(sp.d, sp.growth_rate, "o-", ms=3, color="C1", label="micro: growth rate of the unstable mode (real)")
+    sp = spec[np.isfinite(spec.growth_rate) & (spec.growth_rate > 0)]
+    ax.loglog(sp.d, sp.growth_rate, "o-", ms=3, color="C1", label="micro: real mode (branching ratio -> 1 at V^c)")
+    rs_sp = t.get("rs_spectrum")
+    if rs_sp is not None and len(rs_sp):
+        r = rs_sp[np.isfinite(rs_sp.growth_rate) & (rs_sp.growth_rate > 0)]
+        ax.loglog(r.d, r.growth_rate, "s-", ms=3, color="C0", label="RS, a = 0: slow real mode (its partner: +inf)")
     ax.set_xlabel("d = (V^c - V) / V^c")
-    ax.set_ylabel("growth rate")
-    ax.set_title(f"micro's spectrum below V^c (k0 = {pts.k0.iloc[0]:g}); diverges at V^c", fontsize=9)
+    ax.set_ylabel("growth rate of the unstable mode (per unit time)")
+    ax.set_title(f"The one test (k0 = {k0:g}): the growth rate diverges at V^c in both models\n"
+                 "(a Hopf bifurcation would have it vanish at a finite frequency)", fontsize=9)
     ax.legend(fontsize=7)
     ax = axes[1]
-    styles = {("micro", "cohort"): ("o", "C1"), ("micro", "FP"): ("v", "C4"), ("micro", "N-block"): ("D", "C3"),
-              ("RS", "CVODE"): ("s", "C0")}
+    nb_N = sorted(pts.resolution[pts.method == "N-block"].dropna().unique())
+    nb_colors = ["C2", "C3", "C5", "C6", "C8"]
+    handles: list = []   # (handle, label) in the order drawn: each method's points, then its fit
+
+    def keep(handle, label):
+        handles.append((handle[0] if isinstance(handle, list) else handle, label))
+
     for (name, method, res), grp in pts.groupby(["model", "method", "resolution"], dropna=False, sort=False):
         grp = grp[(grp.regime == "stick-slip") & (grp.amplitude > 0)].sort_values("d")
         if not len(grp):
             continue
-        mark, c = styles.get((name, method), ("^", "C5"))
-        coarse = method == "FP" and res == pts[pts.method == "FP"].resolution.max()
-        small_N = method == "N-block" and res == pts[pts.method == "N-block"].resolution.min()
-        mfc = "none" if (coarse or small_N) else c
-        lab = f"{name} {method}" + ("" if not math.isfinite(res) else (
+        fp = str(method).lower() == "fp"
+        if method == "N-block":
+            mark, c = "D", nb_colors[nb_N.index(res) % len(nb_colors)]
+        else:
+            mark, c = {"cohort": ("o", "C1"), "CVODE": ("s", "C0")}.get(method, ("v", "C4") if fp else ("^", "C9"))
+        lab = f"{name} {'FP' if fp else method}" + ("" if not math.isfinite(res) else (
             f" N={res:.0f}" if method == "N-block" else f" h={res:.3g}" if method == "cohort" else f" eps={res:g}"))
-        yerr = grp.amplitude_stderr.fillna(0.0) if "amplitude_stderr" in grp and method != "CVODE" else None
-        ax.errorbar(grp.d, grp.amplitude, yerr=yerr, fmt=mark, color=c, mfc=mfc, ms=5, label=lab)
-        f = fit[(fit.model == name) & (fit.method == method) & (fit.resolution.fillna(-1) == (res if math.isfinite(res) else -1))]
-        if len(f) and not (coarse or small_N):
+        known = grp.amplitude_error_kind.astype(str) != "not known" if "amplitude_error_kind" in grp else \
+            pd.Series(True, index=grp.index)
+        ok, no = grp[known], grp[~known]
+        # (micro's default on top: where it agrees with the N-block, its circle sits inside the diamond)
+        ms, z = (4.5, 4) if method == "cohort" else (6, 3) if method == "N-block" else (5, 3)
+        if len(ok):
+            yerr = ok.amplitude_stderr.fillna(0.0) if name != "RS" else None
+            kinds = set(ok.amplitude_error_kind.astype(str)) if "amplitude_error_kind" in ok else set()
+            bars = ("" if name == "RS" else " (bars: error bound)" if kinds == {"bound"} else
+                    " (bars: standard error)" if kinds == {"standard error"} else " (bars: error)")
+            keep(ax.errorbar(ok.d, ok.amplitude, yerr=yerr, fmt=mark, color=c, ms=ms, capsize=2, lw=1, zorder=z),
+                 lab + bars)
+        if len(no):
+            why = "not converged in eps, not fitted" if fp else "error not known, not fitted"
+            keep(ax.plot(no.d, no.amplitude, mark, color=c, mfc="none", ms=ms, zorder=z), f"{lab}: {why}")
+        f = fit[(fit.model == name) & (fit.method == method)
+                & ((fit.resolution == res) | (fit.resolution.isna() & (not math.isfinite(res))))] if len(fit) else fit
+        if len(f):
             f = f.iloc[0]
-            d = np.geomspace(grp.d.min() * 0.7, grp.d.max() * 1.3, 50)
-            ax.loglog(d, f.prefactor * (f.Vc * d) ** f.exponent, "-", color=c, lw=0.8,
-                      label=f"  fit: beta = {f.exponent:.2f} ± {f.exponent_err:.2f}")
+            d = np.geomspace(f.d_min, f.d_max, 50)
+            keep(ax.plot(d, f.prefactor * (f.Vc * d) ** f.exponent, "-", color=c, lw=0.8),
+                 f"  fit: beta = {f.beta:.2f} [{f.beta_low:.2f}, {f.beta_high:.2f}], d = {f.d_min:.2g}-{f.d_max:.2g}")
+    law = values.get("rs_amplitude_law") or {}
+    rs = pts[(pts.model == "RS") & (pts.regime == "stick-slip")]
+    shown = pts.d[(pts.regime == "stick-slip") & (pts.amplitude > 0)]
+    lo, hi = float(shown.min()) / 2 if len(shown) else 1e-3, min(float(shown.max()) * 1.3, 1.0) if len(shown) else 1.0
+    if math.isfinite(law.get("c0", math.nan)) and len(rs):
+        d = np.geomspace(lo, rs.d.max(), 100)
+        keep(ax.plot(d, law["c0"] * np.sqrt(d) * (1 + law["c2"] * d), "--", color="k", lw=1),
+             f"RS asymptote c0 d^1/2 (1 + c2 d), c0 = {law['c0']:.4g}, c2 = {law['c2']:.3g} (derived)")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.set_xlim(lo, hi)
+    if lo < NEAR_VC:
+        keep(ax.axvspan(lo, min(NEAR_VC, hi), color="0.5", alpha=0.1, lw=0),
+             f"d < {NEAR_VC:g}: micro's law not settled (the cohort's error not known)")
+    ax.text(0.02, 0.97, "micro: no asymptote derived yet", transform=ax.transAxes, ha="left", va="top",
+            fontsize=8, color="C1")
     ax.set_xlabel("d = (V^c - V) / V^c (each model's own exact V^c)")
     ax.set_ylabel("sigma_max - sigma_min")
-    ax.set_title("Amplitude near V^c (open: smaller N; bars: error where known)", fontsize=9)
-    ax.legend(fontsize=6)
+    ax.set_title("Amplitude near V^c: points with their errors, fitted laws [95 % CI] over the d they rest on,\n"
+                 "RS's derived asymptote (micro: none derived)", fontsize=9)
+    ax.legend([hd for hd, _ in handles], [lb for _, lb in handles], fontsize=6, loc="lower right")
     return _save(fig, path)
 
 

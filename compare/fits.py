@@ -8,7 +8,8 @@ r"""Fits that connect the microscopic model to rate-and-state friction.
 * :func:`dc_from_critical_velocity` — the closed form that matches the RS critical
   velocity to micro's, k0·D_c = W(V^c) = A V^c/(V^c + B)^2.
 * :func:`fit_power_law` — the Hopf scaling σ_max − σ_min ∝ (V^c − V)^β, with V^c given or
-  fitted.
+  fitted; :func:`transition_fits` — one such law per method of the transition study, with
+  its confidence interval and the range of d it rests on.
 * :func:`fit_growth_law` — the three growth laws of the slide-hold-slide peak.
 """
 from __future__ import annotations
@@ -39,6 +40,8 @@ __all__ = [
     "classify_transition",
     "PowerLawFit",
     "fit_power_law",
+    "transition_fits",
+    "AMPLITUDE_ERROR_KINDS",
     "GrowthFit",
     "GROWTH_LAWS",
     "fit_growth_law",
@@ -905,6 +908,123 @@ def fit_power_law(V, amplitude, *, Vc: float | None = None) -> PowerLawFit:
     gap = math.exp(sol.x[2])
     return PowerLawFit(float(sol.x[0]), float(err[0]), float(math.exp(sol.x[1])), vmax + gap, float(gap * err[2]),
                        True, int(V.size), float(math.sqrt(np.mean(sol.fun ** 2))))
+
+
+#: How a transition point's amplitude error is known (the column ``amplitude_error_kind`` of
+#: the report's ``hopf_points``); :func:`transition_fits` fits only the points whose error is known.
+AMPLITUDE_ERROR_KINDS: dict[str, str] = {
+    "bound": "a bound on the error: the cohort method's discretisation error (the change from twice the time "
+             "step and cell) plus its fixed point's, for each extremum",
+    "standard error": "a standard error: the N-block's, from the spread of its cycles",
+    "solver tolerance": "below the solver's tolerance (RS by CVODE at rtol 1e-11): no bar",
+    "not known": "not known (the cohort method closer to V^c than micro.api.NEAR_VC; the Fokker-Planck "
+                 "equation without a study in eps): drawn open, not fitted",
+}
+
+
+def transition_fits(points: pd.DataFrame, *, level: float = 0.95) -> pd.DataFrame:
+    r"""The amplitude law :math:`\sigma_{max} - \sigma_{min} = c\,(V^c - V)^\beta` of each
+    method of a transition study, with the confidence interval of β and the range of
+    :math:`d = (V^c - V)/V^c` it rests on.
+
+    One fit per (model, method, resolution) group of ``points``, by
+    :func:`fit_power_law` at the group's exact ``Vc``, on its stick-slip points with an
+    amplitude > 0 whose error is known: a point whose ``amplitude_error_kind`` is
+    ``'not known'`` (:data:`AMPLITUDE_ERROR_KINDS`) is left out and counted in
+    ``n_not_fitted``, so a method none of whose points has a known error (a
+    Fokker-Planck cycle not converged in eps) has no row.
+
+    The interval is at ``level``: Student's t with n − 2 degrees of freedom on the
+    scatter about the line (``exponent_err``), combined in quadrature with what the
+    points' own error bars can move the slope (the slope's weights
+    :math:`(x_i - \bar x)/S_{xx}` on :math:`\ln` amplitude, :math:`x = \ln d`, times the
+    relative error :math:`e_i/A_i`): summed in absolute value for bounds, at the normal
+    quantile of ``level`` in quadrature for standard errors.  The scatter term is large
+    with few points (t = 12.7 for 3 points at 95 %): the interval says how little three
+    points settle.
+
+    Parameters
+    ----------
+    points : DataFrame
+        Columns ``model, method, resolution, V, Vc, d, regime, amplitude``; optional
+        ``amplitude_stderr`` (the error bar of the amplitude) and
+        ``amplitude_error_kind`` (a key of :data:`AMPLITUDE_ERROR_KINDS`; without it
+        every point counts as known, without a bar).
+    level : float
+        Confidence level of ``beta_low, beta_high``, in (0, 1); default 0.95.
+
+    Returns
+    -------
+    DataFrame
+        One row per fitted group, in the order the groups first appear: ``model, method,
+        resolution``, :meth:`PowerLawFit.to_dict`'s columns (``exponent, exponent_err,
+        prefactor, Vc, Vc_err, Vc_fitted, n_points, rms_log``), then ``beta`` (=
+        ``exponent``), ``beta_low, beta_high, ci_level, ci_basis`` (what the interval
+        covers), ``d_min, d_max`` (the fitted points' range), ``n_not_fitted``, and
+        ``error_kind`` (of the fitted points).
+
+    Raises
+    ------
+    ValueError
+        If ``level`` is not in (0, 1) or ``points`` lacks a column.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from compare.fits import transition_fits
+    >>> d = np.array([0.01, 0.03, 0.1, 0.3])
+    >>> pts = pd.DataFrame({"model": "RS", "method": "CVODE", "resolution": np.nan, "Vc": 1.0, "d": d,
+    ...                     "V": 1.0 - d, "regime": "stick-slip", "amplitude": 0.2 * d ** 0.5})
+    >>> row = transition_fits(pts).iloc[0]
+    >>> round(float(row.beta), 6), float(row.d_min), float(row.d_max), int(row.n_points)
+    (0.5, 0.01, 0.3, 4)
+    """
+    from scipy import stats
+
+    if not 0.0 < float(level) < 1.0:
+        raise ValueError(f"level must lie in (0, 1), got {level!r}")
+    need = {"model", "method", "resolution", "V", "Vc", "d", "regime", "amplitude"}
+    missing = need - set(points.columns)
+    if missing:
+        raise ValueError(f"points must have columns {sorted(need)}; missing {sorted(missing)}")
+    rows = []
+    for (name, method, res), grp in points.groupby(["model", "method", "resolution"], dropna=False, sort=False):
+        cyc = grp[(grp.regime == "stick-slip") & np.isfinite(grp.amplitude) & (grp.amplitude > 0)]
+        kind = (cyc.amplitude_error_kind.fillna("not known").astype(str) if "amplitude_error_kind" in cyc
+                else pd.Series("solver tolerance", index=cyc.index))
+        use = cyc[kind != "not known"]
+        kind = kind[use.index]
+        if not len(use):
+            if len(cyc):
+                log.info("amplitude law %s %s %s: no point with a known error (%d shown, not fitted)",
+                         name, method, res, len(cyc))
+            continue
+        try:
+            f = fit_power_law(use.V, use.amplitude, Vc=float(use.Vc.iloc[0]))
+        except (ValueError, IndexError) as exc:
+            log.warning("amplitude law %s %s %s: %s", name, method, res, exc)
+            continue
+        x = np.log(use.d.to_numpy(float))
+        xc = x - x.mean()
+        w = xc / float(xc @ xc)
+        err = use.amplitude_stderr.to_numpy(float) if "amplitude_stderr" in use else np.full(len(use), np.nan)
+        rel = np.where(np.isfinite(err), err, 0.0) / use.amplitude.to_numpy(float)
+        is_bound = (kind == "bound").to_numpy()
+        is_se = (kind == "standard error").to_numpy()
+        bound = float(np.sum(np.abs(w[is_bound]) * rel[is_bound]))
+        se_pts = float(stats.norm.ppf(0.5 + level / 2) * math.sqrt(np.sum((w[is_se] * rel[is_se]) ** 2)))
+        dof = f.n_points - 2
+        scatter = float(stats.t.ppf(0.5 + level / 2, dof)) * f.exponent_err
+        half = math.sqrt(scatter ** 2 + bound ** 2 + se_pts ** 2)
+        basis = f"t ({dof} dof) on the scatter" + (" + the points' error bounds" if is_bound.any() else "") + (
+            " + the points' standard errors" if is_se.any() else "")
+        kinds = sorted(set(kind))
+        rows.append({"model": name, "method": method, "resolution": res, **f.to_dict(),
+                     "beta": f.exponent, "beta_low": f.exponent - half, "beta_high": f.exponent + half,
+                     "ci_level": float(level), "ci_basis": basis, "d_min": float(use.d.min()),
+                     "d_max": float(use.d.max()), "n_not_fitted": int(len(cyc) - len(use)),
+                     "error_kind": ", ".join(kinds)})
+    return pd.DataFrame(rows)
 
 
 # ============================================================================ growth laws

@@ -1,10 +1,15 @@
-r"""The transition at ``hopf_k0`` (scenario ``hopf``).
+r"""The transition at ``hopf_k0`` (scenario ``hopf``), on both sides.
 
-Micro's spectrum below V^c (the growth rate of the unstable mode, from the shared exact
-branch) and its stick-slip amplitude against d = (V^c - V)/V^c: micro's default method
-(the cohort method's cycles, with their error where it is known) and the N-block at two
-sizes, next to RS's Hopf scaling, each against its own exact V^c; a power law fitted to
-each, and :func:`compare.fits.classify_transition`'s verdict.
+The one test of how steady sliding loses stability, for both models: the growth rate of
+the unstable mode against d = (V^c - V)/V^c (micro's from the shared exact branch, RS's at
+a = 0 from :func:`rsf.transition_spectrum`).  Both models' stick-slip amplitude against d,
+each against its own exact V^c: micro's default method (the cohort method's cycles, with
+their error where it is known) and the N-block at two sizes; RS's cycles with the
+asymptote derived from its stick-slip map (:func:`rsf.stick_slip_normal_form`; micro has
+none derived yet).  One power law per method (:func:`compare.fits.transition_fits`: its
+exponent, confidence interval and the range of d it rests on; only points whose error is
+known), :func:`compare.fits.classify_transition`'s evidence, and the verdict as one
+paragraph (:func:`verdict`).
 """
 from __future__ import annotations
 
@@ -29,6 +34,19 @@ from . import Part
 NAME = "hopf"
 
 log = logging.getLogger(__name__)
+
+
+#: d of RS's spectrum (``rs_spectrum``): the one test's near (1e-6) and far (0.5) ends and a
+#: curve between them for the figure (closed forms at a = 0: no cost).
+RS_SPECTRUM_D = (1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 0.03, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9)
+
+#: The columns of ``hopf_points`` (the first thirteen are read by other scripts: keep them).
+POINT_COLUMNS = ["model", "method", "resolution", "k0", "V", "Vc", "d", "regime", "sigma_max", "sigma_min",
+                 "amplitude", "amplitude_stderr", "period", "amplitude_error_kind", "discretisation_error",
+                 "sigma_stderr", "converged", "asymptote"]
+
+#: The order of ``hopf_fit``'s rows: RS, then micro's default (the cohort), the N-block by N, the FP.
+_ORDER = {("RS", "CVODE"): 0, ("micro", "cohort"): 1, ("micro", "N-block"): 2, ("micro", "fp"): 3, ("micro", "FP"): 3}
 
 
 def wanted(settings: Settings) -> bool:
@@ -61,11 +79,31 @@ def _nblock_tasks(ctx: Context) -> list[NBlockTask]:
             for d in s.nblock_distances]
 
 
+def cycle_errors(frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` (micro's cycles, as from :func:`micro.stationary`) with the error bar of
+    each amplitude, ``amplitude_stderr``, and how it is known, ``amplitude_error_kind``.
+
+    The bar is twice the sum of the row's ``discretisation_error`` and ``sigma_stderr``
+    (each extremum's error, both extrema): a ``'bound'`` where the discretisation error
+    is known (the cohort method at d >= ``micro.api.NEAR_VC``), ``'not known'`` (NaN)
+    where it is not: the cohort closer to V^c, and every Fokker-Planck row (micro's
+    fallback where the cohort method does not apply, or ``cycle_method='fp'``), which has
+    no study in eps here, so that no FP point enters a fit unless it is converged in eps.
+    """
+    f = frame.copy()
+    disc = f.discretisation_error if "discretisation_error" in f else pd.Series(math.nan, index=f.index)
+    stderr = f.sigma_stderr if "sigma_stderr" in f else pd.Series(math.nan, index=f.index)
+    f["amplitude_stderr"] = 2.0 * (disc.astype(float) + stderr.astype(float))
+    f["amplitude_error_kind"] = np.where(np.isfinite(f.amplitude_stderr), "bound", "not known")
+    return f
+
+
 def run(ctx: Context) -> Part:
     """The transition at ``hopf_k0``: micro's spectrum and its stick-slip amplitude
     against (V^c - V)/V^c (micro's default method, the cohort's cycles with their
-    error where it is known; the N-block at two sizes) next to RS's Hopf scaling, each
-    against its own V^c."""
+    error where it is known; the N-block at two sizes) next to RS's spectrum, amplitude
+    and derived asymptote, each against its own V^c; the fits (``hopf_fit``) and the
+    verdict (``values['transition_verdict']``)."""
     s = ctx.s
     part = Part()
     k0 = s.hopf_k0
@@ -75,10 +113,7 @@ def run(ctx: Context) -> Part:
     f = micro_frame(ctx.run(cyc, "micro amplitude"))
     if len(f):
         f["resolution"] = f["eps"]
-        # an error bar on each extremum: the discretisation's (NaN where not known) and the fixed point's
-        if "discretisation_error" in f:
-            f["amplitude_stderr"] = 2.0 * (f.discretisation_error + f.sigma_stderr)
-        rows.append(f)
+        rows.append(cycle_errors(f))
     for N in s.nblock_N:
         tasks_N = [t for t in nb if t.n_blocks == N]
         recs = ctx.run(tasks_N, "micro amplitude (N-block)")
@@ -92,47 +127,71 @@ def run(ctx: Context) -> Part:
         micro_pts["model"], micro_pts["k0"], micro_pts["Vc"] = "micro", k0, vc
         micro_pts["d"] = 1.0 - micro_pts.V / vc
         micro_pts["amplitude"] = micro_pts.sigma_max - micro_pts.sigma_min
+        nb_rows = micro_pts.method == "N-block"
         if "sigma_max_stderr" in micro_pts:
-            nb_rows = micro_pts.method == "N-block"
             micro_pts.loc[nb_rows, "amplitude_stderr"] = np.hypot(micro_pts.sigma_max_stderr,
                                                                   micro_pts.sigma_min_stderr)[nb_rows]
+        micro_pts.loc[nb_rows, "amplitude_error_kind"] = np.where(
+            np.isfinite(micro_pts.amplitude_stderr[nb_rows].astype(float)), "standard error", "not known")
     model = rsf.SpringSlider(law=ctx.law_for(k0), k0=k0, Dc=ctx.Dc)
     rs = rs_hopf(model, s.rs_hopf_distances)
     rs["model"], rs["k0"], rs["method"], rs["resolution"] = "RS", k0, "CVODE", math.nan
-    cols = ["model", "method", "resolution", "k0", "V", "Vc", "d", "regime", "sigma_max", "sigma_min",
-            "amplitude", "amplitude_stderr", "period"]
-    points = pd.concat([micro_pts, rs], ignore_index=True).reindex(columns=cols)
+    rs["amplitude_error_kind"] = "solver tolerance"
+    # RS by the same test as micro (the growth rate of the unstable mode against d), and its
+    # amplitude law from the stick-slip map (rsf.normal_form: sigma_max - sigma_min =
+    # c0 d^(1/2) (1 + c2 d), derived, not fitted)
+    c0 = c2 = math.nan
+    try:
+        rs_spec = rsf.transition_spectrum(model, RS_SPECTRUM_D)
+        part.tables["rs_spectrum"] = rs_spec
+        part.values["rs_transition"] = rsf.classify_spectrum(rs_spec)
+        nf = rsf.stick_slip_normal_form(model)
+        c0, c2 = float(nf.prefactor), float(nf.correction)
+        part.values["rs_amplitude_law"] = {"c0": c0, "c2": c2}
+    except ValueError as exc:  # (no finite RS V^c at this k0 and D_c)
+        log.warning("RS transition at k0 = %g: %s", k0, exc)
+    rs["asymptote"] = c0 * np.sqrt(rs.d) * (1.0 + c2 * rs.d)
+    points = pd.concat([micro_pts, rs], ignore_index=True).reindex(columns=POINT_COLUMNS)
+    points["amplitude_error_kind"] = points.amplitude_error_kind.fillna("not known")
+    points["fitted"] = ((points.regime == "stick-slip") & (points.amplitude > 0)
+                        & (points.amplitude_error_kind != "not known"))
     part.tables["hopf_points"] = points
-    fit_rows = []
-    for (name, method, res), grp in points.groupby(["model", "method", "resolution"], dropna=False):
-        grp = grp[(grp.regime == "stick-slip") & (grp.amplitude > 0)]
-        try:
-            f = fits.fit_power_law(grp.V, grp.amplitude, Vc=float(grp.Vc.iloc[0]))
-        except (ValueError, IndexError) as exc:
-            log.warning("amplitude law %s %s %s: %s", name, method, res, exc)
-            continue
-        fit_rows.append({"model": name, "method": method, "resolution": res,
-                         "Vc_mode": "exact (direct)" if name == "micro" else "exact (linear stability)",
-                         **f.to_dict()})
-    part.tables["hopf_fit"] = pd.DataFrame(fit_rows)
+    part.tables["hopf_fit"] = _fit_table(points)
     b = ctx.branch
     spec = b[(b.role == "branch") & np.isclose(b.k0, k0) & (b.V < vc)].sort_values("V")
     part.tables["micro_spectrum"] = spec[["k0", "V", "Vc", "branching_ratio", "stable", "growth_rate"]].assign(
         d=1.0 - spec.V / vc)
     part.values["transition"] = fits.classify_transition(part.tables["micro_spectrum"], part.tables["hopf_fit"],
                                                          points)
-    # RS by the same test (the growth rate of the unstable mode against d), and its
-    # amplitude law from the stick-slip map (rsf.normal_form: sigma_max - sigma_min =
-    # c0 d^(1/2) (1 + c2 d), derived, not fitted)
-    try:
-        rs_spec = rsf.transition_spectrum(model, [1e-6, 1e-4, 1e-2, 0.5])
-        part.tables["rs_spectrum"] = rs_spec
-        part.values["rs_transition"] = rsf.classify_spectrum(rs_spec)
-        nf = rsf.stick_slip_normal_form(model)
-        part.values["rs_amplitude_law"] = {"c0": float(nf.prefactor), "c2": float(nf.correction)}
-    except ValueError as exc:  # (no finite RS V^c at this k0 and D_c)
-        log.warning("RS transition at k0 = %g: %s", k0, exc)
+    part.values["transition_verdict"] = verdict(s, part.tables, part.values)
     return part
+
+
+def _fit_table(points: pd.DataFrame) -> pd.DataFrame:
+    """``hopf_fit``: one row per method (:func:`compare.fits.transition_fits`), in the
+    order RS, micro's cohort, the N-block by N, the FP; with each model's V^c and its
+    asymptote (RS: derived, and the simulated amplitude over it at the smallest fitted d;
+    micro: none derived yet)."""
+    fit = fits.transition_fits(points)
+    if not len(fit):
+        return fit
+    fit.insert(3, "Vc_mode", np.where(fit.model == "micro", "exact (direct)", "exact (linear stability)"))
+    key = [_ORDER.get((m, k), 9) for m, k in zip(fit.model, fit.method)]
+    fit = fit.assign(_key=key).sort_values(["_key", "resolution"], kind="stable").drop(columns="_key")
+    fit = fit.reset_index(drop=True)
+    ratio, text = [], []
+    for _, r in fit.iterrows():
+        grp = points[(points.model == r.model) & (points.method == r.method) & points.fitted.astype(bool)
+                     & ((points.resolution == r.resolution) | (points.resolution.isna() & pd.isna(r.resolution)))]
+        near = grp.sort_values("d").iloc[0] if len(grp) else None
+        if r.model == "RS" and near is not None and math.isfinite(near.asymptote):
+            ratio.append(float(near.amplitude / near.asymptote))
+            text.append("c0 d^(1/2) (1 + c2 d), derived")
+        else:
+            ratio.append(math.nan)
+            text.append("none derived" if r.model == "micro" else "")
+    fit["asymptote"], fit["asymptote_ratio_at_d_min"] = text, ratio
+    return fit
 
 
 def draw(ctx: Context, part: Part, out) -> dict[str, Path]:
@@ -140,38 +199,114 @@ def draw(ctx: Context, part: Part, out) -> dict[str, Path]:
     return {"hopf": figures.hopf(t, v, figures.target(out, "hopf.png"))}
 
 
+def _resolution(r, s: Settings) -> str:
+    """A fit row's or point's resolution as text (N, the cohort's cell and step, the FP's bin)."""
+    res = float(r.resolution)
+    if not math.isfinite(res):
+        return ""
+    if r.method == "N-block":
+        return f"N = {res:.0f}"
+    if r.method == "cohort":
+        return f"h = {res:.3g}, dt = {s.cycle_dt:g}"
+    return f"eps = {res:g}"
+
+
+def _beta(r) -> str:
+    """beta and its interval, for a sentence."""
+    return (f"beta = {r.beta:.2f} ({100 * r.ci_level:.0f} % CI {r.beta_low:.2f} to {r.beta_high:.2f}) over "
+            f"d = {fmt(r.d_min, 2)} to {fmt(r.d_max, 2)}")
+
+
+def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
+    """The transition's verdict, one paragraph: how each model loses stability (the one
+    test: the unstable mode's growth rate against d), RS's derived amplitude law and
+    micro's fitted ones with their ranges and intervals, and where micro's is not settled."""
+    tr, rs_tr = v.get("transition", {}), v.get("rs_transition") or {}
+    law = v.get("rs_amplitude_law", {})
+    fit = t.get("hopf_fit", pd.DataFrame())
+    pts = t.get("hopf_points", pd.DataFrame())
+    out = []
+    micro_div, rs_div = tr.get("growth_diverges"), rs_tr.get("growth_diverges")
+    if micro_div and rs_div:
+        out.append("At a = 0 both models lose stability at V^c in the same singular way, and neither by a Hopf "
+                   "bifurcation: the growth rate of the unstable mode of steady sliding diverges as V → V^c instead "
+                   f"of vanishing, micro's from {fmt(tr['growth_far'], 3)} at d = {tr['d_far']:.2g} to "
+                   f"{fmt(tr['growth_near'], 3)} at d = {tr['d_near']:.2g} (a real eigenvalue entering from "
+                   "infinity where the branching ratio reaches 1), RS's from "
+                   f"{fmt(rs_tr['growth_far'], 3)} at d = {rs_tr['d_far']:.2g} to {fmt(rs_tr['growth_near'], 3)} "
+                   f"at d = {rs_tr['d_near']:.2g} (the limit a → 0 of the Hopf pair of a > 0, whose frequency grows "
+                   "like a^(-1/2); its partner is the instantaneous slip). They differ in the nonlinear mechanism "
+                   "that sets the amplitude.")
+    else:
+        said = []
+        for who, x in (("micro", tr), ("RS (a = 0)", rs_tr)):
+            if "growth_diverges" in x:
+                how = "diverges" if x["growth_diverges"] else "vanishes"
+                said.append(f"the growth rate of {who}'s unstable mode {how}"
+                            f" as V → V^c ({fmt(x['growth_far'], 3)} at d = {x['d_far']:.2g}, "
+                            f"{fmt(x['growth_near'], 3)} at d = {x['d_near']:.2g})")
+        if said:
+            out.append("By one test, " + "; ".join(said) + ".")
+    rs_fit = fit[fit.model == "RS"] if len(fit) else fit
+    if math.isfinite(law.get("c0", math.nan)):
+        rs = pts[(pts.model == "RS") & pts.fitted.astype(bool)].sort_values("d") if len(pts) else pts
+        check = ""
+        if len(rs) and math.isfinite(rs.asymptote.iloc[0]):
+            dev = abs(rs.amplitude.iloc[0] / rs.asymptote.iloc[0] - 1)
+            check = f"; the simulated amplitude differs from it by a relative {dev:.1g} at d = {rs.d.iloc[0]:.2g}"
+        out.append("In RS the cycle is a stick and an instantaneous slip, whose return map gives "
+                   f"sigma_max − sigma_min = c0 d^(1/2) (1 + c2 d) with c0 = {fmt(law['c0'], 4)} and "
+                   f"c2 = {fmt(law['c2'], 3)} (derived, not fitted{check})"
+                   + (f"; a power law fitted to it gives {_beta(rs_fit.iloc[0])}" if len(rs_fit) else "") + ".")
+    elif len(rs_fit):
+        out.append(f"RS's amplitude, fitted: {_beta(rs_fit.iloc[0])}.")
+    mf = fit[fit.model == "micro"] if len(fit) else fit
+    said = []
+    for _, r in mf.iterrows():
+        how = ("the cohort method" if r.method == "cohort" else f"the N-block at N = {r.resolution:.0f}"
+               if r.method == "N-block" else f"the {r.method} at {_resolution(r, s)}")
+        said.append(f"{_beta(r)} by {how} ({int(r.n_points)} points)")
+    out.append("In micro the amplitude is set by the size of its shocks, and no asymptotic law for it is derived "
+               "yet" + (": fitted, " + "; ".join(said) if said else "; no amplitude law could be fitted") + ".")
+    if micro_div and rs_div:
+        out.append("An exponent near 1/2 is therefore no evidence of a Hopf bifurcation.")
+    nb = mf[mf.method == "N-block"] if len(mf) else mf
+    each_N = ", ".join(f"{r.beta:.2f} at N = {r.resolution:.0f}" for _, r in nb.iterrows())
+    moves = f"; the N-block's exponent moves with N ({each_N})" if len(nb) > 1 else ""
+    out.append(f"Micro's law near V^c is not yet settled below d = {NEAR_VC:g}: the cohort method's "
+               "discretisation error is not known there, and a cell-mass floor in the cohort method was found to "
+               f"shift sigma_max near V^c (its fix is pending){moves}.")
+    return " ".join(out)
+
+
 def summary(ctx: Context, part: Part) -> list[str]:
     s, t, v = ctx.s, part.tables, part.values
+    fit, pts = t["hopf_fit"], t["hopf_points"]
     lines = [f"## The transition at k0 = {s.hopf_k0:g}", "",
-             "Amplitude sigma_max − sigma_min ∝ d^beta, d = (V^c − V)/V^c with each model's own exact V^c:", "",
-             "| model | method | resolution | beta | ± | points |", "|---|---|---|---|---|---|"]
-    for _, r in t["hopf_fit"].iterrows():
-        res = "" if not math.isfinite(r.resolution) else (
-            f"N = {r.resolution:.0f}" if r.method == "N-block" else
-            f"h = {r.resolution:.3g}, dt = {s.cycle_dt:g}" if r.method == "cohort" else f"eps = {r.resolution:g}")
-        lines.append(f"| {r.model} | {r.method} | {res} | {fmt(r.exponent, 3)} | {fmt(r.exponent_err, 2)} | "
-                     f"{int(r.n_points)} |")
+             f"**Verdict: both models by one test.** {v['transition_verdict']}", "",
+             ("Amplitude sigma_max − sigma_min ∝ d^beta, d = (V^c − V)/V^c with each model's own exact V^c "
+              "(table `hopf_fit`; figure `hopf.png`):"), "",
+             "| model | method | resolution | beta | 95 % CI | s.e. | d range | points | asymptote |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for _, r in fit.iterrows():
+        lines.append(f"| {r.model} | {r.method} | {_resolution(r, s)} | {fmt(r.beta, 3)} | "
+                     f"{r.beta_low:.2f} to {r.beta_high:.2f} | {fmt(r.exponent_err, 2)} | {fmt(r.d_min, 2)} to "
+                     f"{fmt(r.d_max, 2)} | {int(r.n_points)} | {r.asymptote} |")
+    unknown = pts[(pts.model == "micro") & (pts.regime == "stick-slip") & ~pts.fitted.astype(bool)]
+    fp = unknown[unknown.method.astype(str).str.lower() == "fp"]
+    near = unknown[unknown.method == "cohort"]
+    lines += ["", "A fit rests only on points whose error is known: the cohort method's bars are bounds (twice the "
+              "sum of its discretisation error, the change from twice the time step and cell, and its fixed-point "
+              "error), the N-block's standard errors (the N-block sizes differ by their finite-N error), RS is "
+              f"exact to CVODE's tolerance. Closer to V^c than d = {NEAR_VC:g} the cohort's discretisation error "
+              "is not known (the cell refinement is not yet shown to converge there): such points are drawn open "
+              "and not fitted" + (f" ({len(near)} here)" if len(near) else " (none here)") + ". The 95 % interval "
+              "combines Student's t on the scatter about the line (n − 2 degrees of freedom, so it is wide with few "
+              "points) with what the points' error bars can move the slope (column `ci_basis`)."
+              + (f" {len(fp)} Fokker-Planck points (eps = {', '.join(f'{e:g}' for e in sorted(set(fp.resolution)))})"
+                 " are shown open but not fitted: they are not converged in eps (no study in eps here)."
+                 if len(fp) else ""), ""]
     tr = v.get("transition", {})
-    lines += ["", tr.get("text", ""), "",
-              "Micro's cycles come from its default method, the cohort method: each point's error bar in "
-              "`hopf.png` is twice the sum of its discretisation error (the change from twice the time step and "
-              f"cell) and its fixed-point error; closer to V^c than d = {NEAR_VC:g} the discretisation error is "
-              "not known (the cell refinement is not yet shown to converge there), and such points carry no bar. "
-              "The N-block sizes differ by their finite-N error.", ""]
-    rs_tr = v.get("rs_transition")
-    if rs_tr:
-        law = v.get("rs_amplitude_law", {})
-        verdict = "diverges" if rs_tr["growth_diverges"] else "vanishes"
-        lines += [f"**Both models by one test.** The growth rate of RS's unstable mode (a = 0, the paper's Eqs. "
-                  f"11-12) {verdict} as V -> V^c: {fmt(rs_tr['growth_far'], 3)} at d = {rs_tr['d_far']:.2g}, "
-                  f"{fmt(rs_tr['growth_near'], 3)} at d = {rs_tr['d_near']:.2g} (table `rs_spectrum`). "
-                  + ("Like micro's, RS's steady sliding at a = 0 loses stability by an eigenvalue entering from "
-                     "infinity (its partner is the instantaneous slip), not by a Hopf bifurcation; only a direct "
-                     "effect a > 0 makes it one (`rsf.hopf_normal_form`: supercritical for the paper's law with the "
-                     "aging and slip laws, docs/reference/rsf.md §19). " if rs_tr["growth_diverges"] else "")
-                  + "The two models differ in the nonlinear mechanism that sets the amplitude: in RS at a = 0 the "
-                  "cycle is a stick and an instantaneous slip whose return map gives sigma_max − sigma_min = "
-                  f"c0 d^(1/2) (1 + c2 d) with c0 = {fmt(law.get('c0', math.nan), 4)} and c2 = "
-                  f"{fmt(law.get('c2', math.nan), 3)} here (derived, `rsf.stick_slip_normal_form`); in micro it is "
-                  "set by the size of its shocks. An exponent of 1/2 is no evidence of a Hopf bifurcation.", ""]
+    if tr.get("text"):
+        lines += [tr["text"], ""]
     return lines

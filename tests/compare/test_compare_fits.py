@@ -158,6 +158,77 @@ def test_classify_transition_tells_hopf_from_a_divergent_growth_rate():
     assert branching["hopf"] is False and branching["period_exponent"] == pytest.approx(0.7, rel=1e-9)
 
 
+def _transition_points(d, amp, *, model="micro", method="cohort", resolution=0.0055, err=None, kind="bound"):
+    d = np.asarray(d, float)
+    return pd.DataFrame({"model": model, "method": method, "resolution": resolution, "Vc": 0.7, "V": 0.7 * (1 - d),
+                         "d": d, "regime": "stick-slip", "amplitude": np.asarray(amp, float),
+                         "amplitude_stderr": np.nan if err is None else np.asarray(err, float),
+                         "amplitude_error_kind": kind})
+
+
+def test_transition_fits_interval_is_students_t_on_the_scatter(rng):
+    """Points without bars: the interval is beta ± t(0.975, n - 2) times the slope's
+    standard error, both from scipy's linregress (independent of rsf.fit_power_law)."""
+    from scipy import stats
+
+    d = np.geomspace(0.02, 0.6, 6)
+    amp = 0.09 * d ** 0.55 * np.exp(0.03 * rng.standard_normal(d.size))
+    row = fits.transition_fits(_transition_points(d, amp, model="RS", method="CVODE", resolution=np.nan,
+                                                  kind="solver tolerance")).iloc[0]
+    lr = stats.linregress(np.log(d), np.log(amp))
+    half = stats.t.ppf(0.975, d.size - 2) * lr.stderr
+    assert row.beta == pytest.approx(lr.slope, rel=1e-10) and row.exponent == row.beta
+    assert row.beta_low == pytest.approx(lr.slope - half, rel=1e-9)
+    assert row.beta_high == pytest.approx(lr.slope + half, rel=1e-9)
+    assert (row.d_min, row.d_max, row.n_points, row.ci_level) == (pytest.approx(0.02), pytest.approx(0.6), 6, 0.95)
+
+
+def test_transition_fits_error_bounds_widen_the_interval_to_the_worst_slope():
+    """An exact power law with error bounds e_i: the interval's half-width is the largest
+    change of the slope with every ln amplitude moved by at most e_i / A_i, found here by
+    refitting the worst case (each point pushed the way its lever arm tilts the line)."""
+    d = np.array([0.2, 0.3, 0.45, 0.6])
+    amp = 0.08 * d ** 0.48
+    err = np.array([2e-4, 4e-4, 7e-4, 6e-4])
+    row = fits.transition_fits(_transition_points(d, amp, err=err)).iloc[0]
+    x = np.log(d)
+    push = np.sign(x - x.mean()) * err / amp
+    worst = np.polyfit(x, np.log(amp) + push, 1)[0]
+    assert row.beta == pytest.approx(0.48, abs=1e-12)
+    assert row.beta_high - row.beta == pytest.approx(worst - 0.48, rel=1e-9)
+    assert row.beta - row.beta_low == pytest.approx(worst - 0.48, rel=1e-9)
+    assert "error bounds" in row.ci_basis
+
+
+def test_transition_fits_leave_out_points_whose_error_is_not_known():
+    """The cohort closer to V^c (error not known) is shown, not fitted; a Fokker-Planck group
+    with no study in eps (every error not known) gets no row; one converged in eps would."""
+    d = np.array([0.05, 0.1, 0.2, 0.3, 0.45, 0.6])
+    cohort = _transition_points(d, 0.08 * d ** 0.5, err=np.where(d >= 0.2, 5e-4, np.nan),
+                                kind=np.where(d >= 0.2, "bound", "not known"))
+    fp = _transition_points(d[2:], 0.078 * d[2:] ** 0.45, method="fp", resolution=0.02, kind="not known")
+    fit = fits.transition_fits(pd.concat([cohort, fp], ignore_index=True))
+    assert list(fit.method) == ["cohort"]
+    row = fit.iloc[0]
+    assert (row.n_points, row.n_not_fitted, row.d_min, row.d_max) == (4, 2, 0.2, 0.6)
+    fp_converged = fp.assign(amplitude_stderr=1e-4, amplitude_error_kind="bound")
+    assert list(fits.transition_fits(fp_converged).method) == ["fp"]
+    with pytest.raises(ValueError, match="level"):
+        fits.transition_fits(cohort, level=1.0)
+
+
+def test_transition_cycle_errors_mark_fp_and_near_vc_rows_not_known():
+    """The scenario's error bars: the cohort's known discretisation error gives a bound,
+    twice (discretisation + fixed point); NaN (the cohort near V^c, any FP row: micro's
+    fallback included) gives 'not known', so no FP point sneaks into a fit."""
+    from compare.scenarios.transition import cycle_errors
+
+    f = cycle_errors(pd.DataFrame({"method": ["cohort", "cohort", "fp"], "discretisation_error": [3e-4, np.nan, np.nan],
+                                   "sigma_stderr": [1e-6, 1e-6, 2e-4]}))
+    assert f.amplitude_stderr.iloc[0] == pytest.approx(2 * (3e-4 + 1e-6), rel=1e-12)
+    assert list(f.amplitude_error_kind) == ["bound", "not known", "not known"]
+
+
 def test_fit_dc_uses_each_k0_s_own_law():
     # the report's situation: one A, B, an offset per k0 (0.87 at k0 = 0.3, 0.89 at 0.1).
     # Stick-slip extrema made by rsf.limit_cycle itself with D_c = 0.07 (and steady points) are
