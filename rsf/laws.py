@@ -831,9 +831,12 @@ class CallableLaw(SteadyStateLaw):
                 raise ValueError(f"mu_ss_fn and dmu_ss_fn must be finite for v > 0; at v = {v:g} "
                                  f"they give {m!r}, {d!r}")
             h = 1e-5 * v
-            fd = (float(self.mu_ss_fn(v + h)) - float(self.mu_ss_fn(v - h))) / (2.0 * h)
-            scale = max(abs(fd), abs(d), 1e-8 * max(1.0, abs(m)) / v)
-            if abs(fd - d) > 1e-4 * scale:
+            up, down = float(self.mu_ss_fn(v + h)), float(self.mu_ss_fn(v - h))
+            fd = (up - down) / (2.0 * h)
+            # the difference's truncation error is relative (1e-10 for smooth laws); its
+            # round-off is absolute, a few ulps of mu over 2h (1e-5 at v = 1e-6 for mu ~ 0.6)
+            roundoff = 8.0 * np.finfo(float).eps * max(abs(up), abs(down), abs(m)) / (2.0 * h)
+            if abs(fd - d) > 1e-4 * max(abs(fd), abs(d)) + roundoff:
                 raise ValueError(f"dmu_ss_fn does not match the derivative of mu_ss_fn at v = {v:g}: "
                                  f"{d!r} against the finite difference {fd!r}")
         if self.w_range is not None:

@@ -366,14 +366,14 @@ class Protocol:
     def load_point(self, t: float) -> float:
         r"""Load-point displacement :math:`X(t) = \int_0^t V\,\mathrm{d}t'`."""
         if self.times.size == 1:
-            return float(self.velocities[0]) * t
+            return float(self.velocities[0]) * float(t)
         i = int(np.searchsorted(self.times, t, side="right")) - 1
         i = max(i, 0)
         tau = t - self.times[i]
         x = float(self._x_at_times[i]) + float(self.velocities[i]) * tau   # type: ignore[attr-defined]
         if self.is_linear:
             x += 0.5 * self.slope_at(t) * tau * tau
-        return x
+        return float(x)
 
     @property
     def is_constant(self) -> bool:

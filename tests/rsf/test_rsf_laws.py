@@ -151,6 +151,16 @@ def test_bad_law_parameters_raise_naming_the_parameter(make, match):
         make()
 
 
+def test_callable_law_accepts_a_correct_derivative_where_mu_dwarfs_v_times_its_slope():
+    # mu = 0.6 - 0.005 v / (1 + v): at v = 1e-6 the central difference's round-off (a few
+    # ulps of mu over 2h = 2e-11, about 1e-5) is far above a relative 1e-4 of the slope
+    # (5e-7); the check must allow for it, and still refuse a wrong derivative there
+    law = rsf.CallableLaw(lambda v: 0.6 - 0.005 * v / (1.0 + v), lambda v: -0.005 / (1.0 + v) ** 2)
+    assert law.mu_ss(1e-6) == pytest.approx(0.6, abs=1e-8)
+    with pytest.raises(ValueError, match="does not match the derivative"):
+        rsf.CallableLaw(lambda v: 0.6 - 0.005 * v / (1.0 + v), lambda v: -0.0051 / (1.0 + v) ** 2)
+
+
 def test_unbound_law_asks_for_k0():
     with pytest.raises(ValueError, match="bind"):
         rsf.HyperbolicLaw().mu_ss(1.0)

@@ -24,6 +24,9 @@ def test_load_point_of_a_sampled_history_is_exact():
     assert proto.velocity_at(3.5) == pytest.approx(1.5)
     assert proto.slope_at(3.5) == pytest.approx(-1.0)
     assert proto.velocity_at(7.0) == 0.0 and proto.slope_at(7.0) == 0.0
+    # a float whatever the time's type (numpy scalars in, Python floats out)
+    for p in (proto, rsf.Protocol.sampled([0.0], [2.0])):
+        assert type(p.load_point(np.float64(3.0))) is float
 
 
 @pytest.mark.parametrize("law", ["aging", "slip"])
