@@ -48,8 +48,9 @@ def main() -> None:
     with Stopwatch(cpu=True) as sw:
         r = C.cycle_cohorts(model, V, dt=a.dt, h=h, tol=2e-5 if a.cycles == 0 else 1e-10,
                             max_iter=max(a.cycles, 200))
-    row = dict(k0=a.k0, V_over_Vc=a.fraction, dt=a.dt, h_div=a.h_div, floor=a.floor, cycles_forced=a.cycles,
-               sigma_max=r.sigma_max, period=r.period, cycles=r.iterations, certified=r.converged, error=r.error,
+    row = dict(k0=a.k0, V_over_Vc=a.fraction, dt=a.dt, h_div=a.h_div, floor=f"{a.floor:g}", cycles_forced=a.cycles,
+               sigma_max=r.sigma_max, period=r.period, cycles=r.iterations,
+               certified=bool(r.converged and r.error == r.error), error=r.error,
                dropped_mass=r.mass_error, cpu_s=sw.seconds, message=r.message)
     print(row)
     path = RESULTS / "micro_cohort_near_vc_check.csv"

@@ -120,7 +120,8 @@ def _cohort_row(model: Model, V: float, opts: Cohort, warn: bool,
     if not res.applicable:
         return None
     d = 1.0 - V / _vc(model)
-    if res.coarse is not None and d >= NEAR_VC:
+    certified = math.isfinite(res.error) and (res.coarse is None or math.isfinite(res.coarse.error))
+    if res.coarse is not None and d >= NEAR_VC and certified:
         # the change of the cycle from twice the step and cell, plus what the two fixed points
         # may still be off (a bound on the coarse cycle's discretisation error, so on this one's)
         change = max(abs(res.sigma_max - res.coarse.sigma_max), abs(res.sigma_min - res.coarse.sigma_min))
@@ -130,8 +131,11 @@ def _cohort_row(model: Model, V: float, opts: Cohort, warn: bool,
     else:
         disc = math.nan
         why = (f"d = (V^c - V)/V^c = {d:.3g} < {NEAR_VC:g}, where the cell refinement is not known to converge"
-               if d < NEAR_VC else "no run at twice the step and cell to compare with")
-        covers = f"; discretisation error not known ({why}); the fixed-point error {res.error:.1e} covers the iteration only"
+               if d < NEAR_VC else "no run at twice the step and cell to compare with" if res.coarse is None
+               else "a fixed point is not certified")
+        covers = (f"; discretisation error not known ({why}); " +
+                  (f"the fixed-point error {res.error:.1e} covers the iteration only" if math.isfinite(res.error)
+                   else "nor is the fixed-point error"))
     if not res.converged and warn:
         log.warning("micro.stationary(k0=%g, V=%g, method='cohort'): %s", model.k0, V, res.message)
     return Stationary(

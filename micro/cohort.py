@@ -943,12 +943,13 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             # the frozen map grows along some mode: it gives no bound on what a slower mode of
             # the full map leaves, and the plain cycles' test alone is not enough (at k0 = 0.01,
             # 0.9 V^c, h = kappa zbar / 40 it passed 3e-5 short of the fixed point that 450
-            # cycles reach, against an estimate of 1.9e-6; docs/validation/micro_cohort.md)
-            error, value = math.nan, np.array(hist[-1])
-            message = (f"no certified fixed point: the cycles pass the stopping test after Anderson's "
-                       f"iteration (its last step {residual:.1e} of the mass), but the frozen map's slowest "
-                       f"multiplier is {slow_multiplier:.4f} >= 1, so nothing bounds a slower mode of the "
-                       f"cycle map; close to V^c use a coarser cell h, or the N-block")
+            # cycles reach, against an estimate of 1.9e-6; docs/validation/micro_cohort.md
+            # section 5): the stopping test is met, but the fixed point's error is not known
+            converged, value, error = True, best, math.nan
+            message = (f"limit cycle by cohorts, its error not known: the cycles pass the stopping test after "
+                       f"Anderson's iteration (its last step {residual:.1e} of the mass), but the frozen map's "
+                       f"slowest multiplier is {slow_multiplier:.4f} >= 1, so nothing bounds a slower mode of "
+                       f"the cycle map (no certified fixed point; measured 3e-5 off where checked)")
             break
         if passed >= 2:  # (two cycles in a row: one estimate may pass by chance)
             converged, value = True, best

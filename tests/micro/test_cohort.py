@@ -520,5 +520,6 @@ def test_a_frozen_map_that_grows_leaves_the_fixed_point_uncertified(monkeypatch)
     V = 0.9 * micro.critical_velocity(model).Vc
     res = cycle_cohorts(model, V, dt=0.04, h=model.kappa * model.zbar / 10.0, start=_NO_COARSE)
     assert seen, "the run was not accelerated: the test no longer exercises the acceleration"
-    assert not res.converged and math.isnan(res.error)
+    # the stopping test is met (so the row stands), but the error is not known
+    assert res.converged and math.isnan(res.error)
     assert "no certified fixed point" in res.message and "1.0300 >= 1" in res.message
