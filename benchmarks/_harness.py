@@ -107,7 +107,8 @@ def warm_up(fn: Callable[..., Any], *args: Any, label: str = "compilation (or nu
 
 def merged(path: Path, new: pd.DataFrame, keys: list[str], replace: pd.DataFrame | None = None) -> pd.DataFrame:
     """``new`` and the rows of the CSV at ``path`` (if any) whose ``keys`` match no row of
-    ``replace`` (default ``new``; numbers compared with np.isclose, other keys exactly).
+    ``replace`` (default ``new``; numbers equal to a relative 1e-9, with no absolute slack, so
+    that 1e-13 and 1e-20 differ; other keys exactly).
     The file is read now, so points another run wrote meanwhile are kept."""
     path = Path(path)
     if not path.exists():
@@ -117,7 +118,7 @@ def merged(path: Path, new: pd.DataFrame, keys: list[str], replace: pd.DataFrame
     same = np.ones((len(old), len(replace)), dtype=bool)
     for key in keys:
         if pd.api.types.is_numeric_dtype(replace[key]):
-            same &= np.isclose(old[key].to_numpy(float)[:, None], replace[key].to_numpy(float))
+            same &= np.isclose(old[key].to_numpy(float)[:, None], replace[key].to_numpy(float), rtol=1e-9, atol=0.0)
         else:
             same &= old[key].to_numpy(str)[:, None] == replace[key].to_numpy(str)
     return pd.concat([old[~same.any(axis=1)], new], ignore_index=True)
