@@ -437,12 +437,42 @@ def slide_hold_slide(
     time stops the drive for ``hold``, resumes at ``V`` for ``resume`` (default: 20 cycle
     times plus 2 relaxation times) and records the largest stress after resuming, by the
     Fokker-Planck equation (``method="auto"`` or ``"fp"``: the cohort method does not
-    carry transients).
+    carry transients).  One stationary run serves every hold time.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    V : float
+        Drive velocity, finite and > 0, where steady sliding is the attractor.
+    hold_times : float or array_like
+        The hold durations, each finite and >= 0 (0: no hold).
+    method : str or FP
+        ``"auto"`` (the default) or ``"fp"``, or a :class:`micro.FP` options object.
+    numerics : FP, optional
+        The Fokker-Planck options (or give them as ``method``, not both).
+    convergence : Convergence, optional
+        The stopping rule of the stationary run before the holds.
+    resume : float, optional
+        How long the drive runs after each hold (default ``20 zbar / V + 2 / gamma``;
+        without the second term where gamma = 0).
 
     Returns
     -------
     pandas.DataFrame
-        ``hold_time, sigma_steady, sigma_peak, delta_sigma_max, method`` per hold.
+        One row per hold: ``hold_time``; ``sigma_steady``, the steady stress at ``V``;
+        ``sigma_peak``, the largest stress after resuming; ``delta_sigma_max =
+        sigma_peak - sigma_steady``; ``method`` (``"fp"``).
+
+    Raises
+    ------
+    ValueError
+        For a bad argument (``model`` not a :class:`micro.Model`, ``V``, a hold time or
+        the bin out of range, or a method other than ``"auto"`` and ``"fp"``), before
+        anything is computed; or, after the stationary run, if the attractor at ``V`` is
+        not steady sliding.
+    micro.GridTooLarge
+        If the Fokker-Planck grid would outgrow ``numerics.max_memory_gib``.
     """
     _check_model(model)
     numerics = _transient_method(method, numerics, "slide_hold_slide")

@@ -51,7 +51,26 @@ EPS_FRACTION = 1.0 / 50.0
 
 
 def default_eps(model: Model) -> float:
-    """The default bin, ``kappa * zbar / 50`` (2e-3 for the paper's parameters)."""
+    """The default bin, ``kappa * zbar / 50`` (2e-3 for the paper's parameters).
+
+    The Fokker-Planck method's ``eps`` when :class:`FP` is given none.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+
+    Returns
+    -------
+    float
+        ``model.kappa * model.zbar / 50``.
+
+    Examples
+    --------
+    >>> import micro
+    >>> round(micro.default_eps(micro.Model(k0=0.01)), 12)       # kappa = 1.01, zbar = 0.1
+    0.00202
+    """
     return model.kappa * model.zbar * EPS_FRACTION
 
 
