@@ -50,7 +50,36 @@ SHARED_FIGURES = ("steady_fit", "dc_profile")
 
 def micro_frame(records: Sequence[dict[str, Any]], **columns: Any) -> pd.DataFrame:
     """Stationary records of a :class:`Runner` as one row each (failed tasks keep their
-    ``error`` with NaN results)."""
+    ``error`` with NaN results).
+
+    Parameters
+    ----------
+    records : sequence of dict
+        Records of :class:`StationaryTask` runs, as :meth:`Runner.run` or
+        :func:`execute` return them.
+    **columns
+        Extra columns, each set on every row (a scalar, or one value per record).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per record: the result's fields (:meth:`micro.Stationary.to_dict`), or
+        for a failed task the model's ``k0, k1, k2, eta_u, f_th`` and ``V`` from its
+        description; then ``status``, ``error`` (empty if none), ``wall_time``, and
+        ``eps`` taken from the task's bin where the row has none (renewal rows, failed
+        tasks); then ``columns``.
+
+    Examples
+    --------
+    >>> import micro
+    >>> from compare import StationaryTask, execute, micro_frame
+    >>> task = StationaryTask(micro.Model(k0=0.1), 2.0, micro.Numerics(), micro.Convergence())
+    >>> frame = micro_frame([execute(task)], role="demo")
+    >>> frame.loc[0, ["method", "regime", "status", "role"]].tolist()
+    ['renewal', 'steady', 'ok', 'demo']
+    >>> round(float(frame.eps[0]), 12)                     # the task's bin, kappa zbar / 50
+    0.0022
+    """
     rows = []
     for rec in records:
         row = dict(rec.get("result") or {})

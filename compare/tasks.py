@@ -135,7 +135,35 @@ class StationaryTask(_TaskBase):
     """``micro.stationary(model, V, method=..., numerics=..., convergence=...)``: ``"auto"``
     (the renewal chain where steady sliding is stable, the cohort method with the options
     ``cohort`` for a stick-slip cycle), ``"cohort"``, or ``"fp"`` (time-steps the
-    Fokker-Planck equation at ``numerics`` even where the direct steady state exists)."""
+    Fokker-Planck equation at ``numerics`` even where the direct steady state exists).
+
+    Its result is the row's :meth:`micro.Stationary.to_dict`; :func:`micro_frame` makes a
+    table of such records.
+
+    Parameters
+    ----------
+    model : micro.Model
+        The model (exponential or deterministic jumps).
+    V : float
+        Drive velocity, finite and > 0.
+    numerics : micro.Numerics
+        The Fokker-Planck options, wherever that method runs.
+    convergence : micro.Convergence
+        The Fokker-Planck runs' stopping rule.
+    method : str
+        ``"auto"`` (default), ``"cohort"`` or ``"fp"``.
+    cohort : micro.Cohort
+        The cohort method's options (default ``micro.Cohort()``); not part of the
+        description (nor of the cache key) when ``method="fp"``.
+
+    Raises
+    ------
+    ValueError
+        If ``V`` is not a finite number > 0, ``method`` is not one of the three,
+        ``model``, ``numerics``, ``convergence`` or ``cohort`` is not of its type, the
+        jumps are :class:`micro.Tabulated` (a density that cannot be hashed), or the bin
+        or the cohort cell is out of range for the model.
+    """
 
     model: micro.Model
     V: float
@@ -173,7 +201,38 @@ class StationaryTask(_TaskBase):
 class CriticalTask(_TaskBase):
     """``micro.critical_velocity(model, V_min=..., V_max=..., rel_tol=..., V_guess=..., factor=..., refine=...)``
     (bracketing outward from ``V_guess`` by ``factor``, then bisection; with ``refine``
-    oscillations smaller than 2 eps are checked at eps / 2)."""
+    oscillations smaller than 2 eps are checked at eps / 2).
+
+    This is the Fokker-Planck bisection (``method="fp"``, minutes); :class:`VcTask` is
+    the renewal chain's exact V^c.  Its result is :meth:`micro.Critical.to_dict` with the
+    bisection's ``evaluations``.
+
+    Parameters
+    ----------
+    model : micro.Model
+        The model (exponential or deterministic jumps).
+    V_min, V_max : float
+        The search range, finite, > 0, with ``V_max > V_min``.
+    rel_tol : float
+        The bracket's relative width at which the bisection stops, in (0, 1).
+    numerics : micro.Numerics
+        The Fokker-Planck options (the bin ``eps``).
+    convergence : micro.Convergence
+        The runs' stopping rule.
+    V_guess : float
+        The first velocity tried, in [V_min, V_max] (default 1).
+    factor : float
+        The step of the outward bracketing, in (1, 1e3] (default 4).
+    refine : bool
+        Check small oscillations at eps / 2 (default True).
+
+    Raises
+    ------
+    ValueError
+        If a velocity, ``rel_tol`` or ``factor`` is out of range, ``model``,
+        ``numerics`` or ``convergence`` is not of its type, the jumps are
+        :class:`micro.Tabulated`, or the bin is out of range for the model.
+    """
 
     model: micro.Model
     V_min: float
@@ -215,7 +274,32 @@ class CriticalTask(_TaskBase):
 
 @dataclass(frozen=True)
 class SlideHoldSlideTask(_TaskBase):
-    """``micro.slide_hold_slide(model, V, hold_times, ...)``."""
+    """``micro.slide_hold_slide(model, V, hold_times, ...)``.
+
+    Its result is ``{"rows": [...]}``, one dict per hold (the frame's columns
+    ``hold_time, sigma_steady, sigma_peak, delta_sigma_max, method``).
+
+    Parameters
+    ----------
+    model : micro.Model
+        The model (exponential or deterministic jumps).
+    V : float
+        Drive velocity, finite and > 0, where steady sliding is the attractor (else the
+        record holds the ``ValueError``).
+    hold_times : sequence of float
+        The hold durations, at least one, each finite and >= 0; kept as a tuple.
+    numerics : micro.Numerics
+        The Fokker-Planck options.
+    convergence : micro.Convergence
+        The stopping rule of the stationary run before the holds.
+
+    Raises
+    ------
+    ValueError
+        If ``V`` or a hold time is out of range, ``hold_times`` is empty, ``model``,
+        ``numerics`` or ``convergence`` is not of its type, the jumps are
+        :class:`micro.Tabulated`, or the bin is out of range for the model.
+    """
 
     model: micro.Model
     V: float
@@ -248,7 +332,38 @@ class SlideHoldSlideTask(_TaskBase):
 @dataclass(frozen=True)
 class SteadyTask(_TaskBase):
     """``micro.steady_sliding(model, V)``: the exact steady state (either branch) at every
-    velocity of ``V``, with the branching ratio and the growth rate of the unstable mode."""
+    velocity of ``V``, with the branching ratio and the growth rate of the unstable mode.
+
+    Its result is ``{"rows": [...], "message": ...}``: one dict per velocity
+    (:meth:`micro.SteadySliding.to_frame`'s columns and ``branching_error``) and the
+    chain's message.
+
+    Parameters
+    ----------
+    model : micro.Model
+        The model (exponential or deterministic jumps).
+    V : sequence of float
+        The drive velocities, at least one, each finite and > 0; kept as a tuple.
+        (:func:`micro.steady_sliding` takes [1e-6, 1e7]: a velocity outside makes the
+        record an error.)
+    tol : float
+        Tolerance of the chain's grid, in [1e-14, 1e-3] (default 1e-11).
+
+    Raises
+    ------
+    ValueError
+        If ``V`` is empty or holds a velocity that is not a finite number > 0, ``tol`` is
+        out of range, ``model`` is not a :class:`micro.Model`, or its jumps are
+        :class:`micro.Tabulated`.
+
+    Examples
+    --------
+    >>> import micro
+    >>> from compare import SteadyTask, execute
+    >>> record = execute(SteadyTask(micro.Model(k0=0.1), (0.5, 2.0)))
+    >>> record["status"], [row["stable"] for row in record["result"]["rows"]]
+    ('ok', [False, True])
+    """
 
     model: micro.Model
     V: tuple[float, ...]
@@ -279,7 +394,21 @@ class SteadyTask(_TaskBase):
 
 @dataclass(frozen=True)
 class VcTask(_TaskBase):
-    """``micro.critical_velocity(model)`` by the direct method: the root of b(V) = 1."""
+    """``micro.critical_velocity(model)`` by the direct method: the root of b(V) = 1.
+
+    Its result is :meth:`micro.Critical.to_dict`.
+
+    Parameters
+    ----------
+    model : micro.Model
+        The model (exponential or deterministic jumps).
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`micro.Model`, or its jumps are
+        :class:`micro.Tabulated`.
+    """
 
     model: micro.Model
     kind = "vc"
@@ -298,7 +427,33 @@ class VcTask(_TaskBase):
 @dataclass(frozen=True)
 class NBlockTask(_TaskBase):
     """The stick-slip extrema of ``n_blocks`` blocks (``micro.nblock.stick_slip_extrema_nblock``):
-    means over ``n_cycles`` global shocks after ``n_discard``, with their standard errors."""
+    means over ``n_cycles`` global shocks after ``n_discard``, with their standard errors.
+
+    Its result holds ``V, n_blocks, regime, sigma_max, sigma_max_stderr, sigma_min,
+    sigma_min_stderr, period, period_stderr, n_cycles, status, message``.
+
+    Parameters
+    ----------
+    model : micro.Model
+        The model (exponential or deterministic jumps).
+    V : float
+        Drive velocity, finite and > 0.
+    n_blocks : int
+        Number of blocks, >= 10.
+    n_cycles : int
+        Global shocks to average over, >= 2 (default 10).
+    n_discard : int
+        Global shocks discarded first as the transient, >= 0 (default 5).
+    seed : int
+        Seed of the random pinning distances, >= 0 (default 0).
+
+    Raises
+    ------
+    ValueError
+        If ``V`` is not a finite number > 0, a count is not an integer (a bool is
+        refused) or is below its bound, ``model`` is not a :class:`micro.Model`, or its
+        jumps are :class:`micro.Tabulated`.
+    """
 
     model: micro.Model
     V: float
@@ -334,7 +489,33 @@ class NBlockTask(_TaskBase):
 @dataclass(frozen=True)
 class TraceTask(_TaskBase):
     """``micro.simulate(model, drive)``: the stress against time under a piecewise-constant
-    drive (``segments`` of (duration, velocity)), thinned to about ``n_samples`` samples."""
+    drive (``segments`` of (duration, velocity)), recorded at least every
+    ``duration / n_samples``.
+
+    Its result is ``{"t": [...], "sigma": [...]}``, the run's records: besides the
+    ``n_samples`` intervals, :func:`micro.simulate` records whenever the stress has moved
+    by a quarter of k0 eps (the grid's jitter), so a trace through stick-slip holds many
+    more samples.
+
+    Parameters
+    ----------
+    model : micro.Model
+        The model (exponential or deterministic jumps).
+    segments : sequence of (float, float)
+        The drive's ``(duration, velocity)`` segments, as :class:`micro.Drive` takes them;
+        kept as a tuple of float pairs.
+    numerics : micro.Numerics
+        The Fokker-Planck options.
+    n_samples : int
+        The duration over the longest interval between records (default 4000).
+
+    Raises
+    ------
+    ValueError
+        If a segment is refused by :class:`micro.Drive`, ``numerics`` is not a
+        :class:`micro.Numerics` or its bin is out of range for the model, or the jumps
+        are :class:`micro.Tabulated`.
+    """
 
     model: micro.Model
     segments: tuple[tuple[float, float], ...]
@@ -380,6 +561,33 @@ def execute(task: Task) -> dict[str, Any]:
     ``status`` is ``"ok"`` with ``result``, or ``"error"`` with ``error`` (the exception
     type and message); ``cacheable`` says whether the record is a deterministic answer
     (results and ``ValueError``) that may be stored.
+
+    Parameters
+    ----------
+    task : Task
+        One of :class:`SteadyTask`, :class:`VcTask`, :class:`NBlockTask`,
+        :class:`TraceTask`, :class:`StationaryTask`, :class:`CriticalTask`,
+        :class:`SlideHoldSlideTask`.
+
+    Returns
+    -------
+    dict
+        ``key`` (the task's cache key), ``task`` (its description), ``code_version``,
+        ``status``, ``result`` or ``error``, ``cacheable`` and ``wall_time`` (seconds).
+
+    Notes
+    -----
+    An exception raised while the task runs is caught and recorded, never raised; an
+    unexpected one (not a ``ValueError``) is also logged with its traceback and is not
+    cacheable.
+
+    Examples
+    --------
+    >>> import micro
+    >>> from compare import VcTask, execute
+    >>> record = execute(VcTask(micro.Model(k0=0.3)))
+    >>> record["status"], record["cacheable"], round(record["result"]["Vc"], 4)
+    ('ok', True, 0.1947)
     """
     start = time.perf_counter()
     record: dict[str, Any] = {"key": task.key, "task": task.describe(), "code_version": code_version()}
