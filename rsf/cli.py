@@ -147,23 +147,23 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
                    help="direct effect a >= 0 (default: the law's a for --law log, else 0, "
                         "the paper's model with stick, slide and instantaneous slip)")
     h = p.add_argument_group("hyperbolic law, Eq. (10)")
-    h.add_argument("--A", type=float, default=PAPER_A, help=f"amplitude A >= 0 (default {PAPER_A})")
-    h.add_argument("--B", type=float, default=PAPER_B, help=f"velocity scale B > 0 (default {PAPER_B})")
+    h.add_argument("--A", type=float, default=None, help=f"amplitude A >= 0 (default {PAPER_A})")
+    h.add_argument("--B", type=float, default=None, help=f"velocity scale B > 0 (default {PAPER_B})")
     h.add_argument("--mu-inf", type=float, default=None,
                    help="large-velocity friction mu_inf (default: the paper's "
                         "f_th - zbar (k0 + k1 + k2)/2 = 0.95 - 0.05 k0, which needs k0 < 19)")
     v = p.add_argument_group("viscoelastic law, Eq. (4)")
-    v.add_argument("--f-th", type=float, default=1.0, help="pinning threshold f_th (default 1)")
-    v.add_argument("--zbar", type=float, default=0.1, help="mean well spacing zbar > 0 (default 0.1)")
-    v.add_argument("--k1", type=float, default=0.1, help="elastic coupling k1 >= 0 (default 0.1)")
-    v.add_argument("--k2", type=float, default=0.9, help="viscoelastic spring k2 > 0 (default 0.9)")
-    v.add_argument("--eta-u", type=float, default=1.0, help="dashpot viscosity eta_u > 0 (default 1)")
+    v.add_argument("--f-th", type=float, default=None, help="pinning threshold f_th (default 1)")
+    v.add_argument("--zbar", type=float, default=None, help="mean well spacing zbar > 0 (default 0.1)")
+    v.add_argument("--k1", type=float, default=None, help="elastic coupling k1 >= 0 (default 0.1)")
+    v.add_argument("--k2", type=float, default=None, help="viscoelastic spring k2 > 0 (default 0.9)")
+    v.add_argument("--eta-u", type=float, default=None, help="dashpot viscosity eta_u > 0 (default 1)")
     lg = p.add_argument_group("log law, Eq. (9) / Eq. (7)")
-    lg.add_argument("--mu0", type=float, default=0.6, help="reference friction mu0 (default 0.6)")
-    lg.add_argument("--b", type=float, default=0.015, help="evolution effect b >= 0 (default 0.015)")
-    lg.add_argument("--law-a", type=float, default=0.01,
+    lg.add_argument("--mu0", type=float, default=None, help="reference friction mu0 (default 0.6)")
+    lg.add_argument("--b", type=float, default=None, help="evolution effect b >= 0 (default 0.015)")
+    lg.add_argument("--law-a", type=float, default=None,
                     help="a of the log steady state mu0 + (a-b) ln(v/v0) (default 0.01)")
-    lg.add_argument("--v0", type=float, default=1.0, help="reference velocity v0 > 0 (default 1)")
+    lg.add_argument("--v0", type=float, default=None, help="reference velocity v0 > 0 (default 1)")
     t = p.add_argument_group("table law")
     t.add_argument("--table", default=None,
                    help="CSV file with a velocity and a friction column (with --law table only; "
@@ -251,8 +251,30 @@ _TABLE_OPTIONS = {"path": "--table", "where": "--table-where", "v_column": "--ta
                   "mu_column": "--table-mu-column"}
 
 
+#: Each law's own options (the Namespace's names, their options and their defaults): an
+#: option of another law than --law's is refused (it would be ignored), then the chosen
+#: law's options not given take their defaults.
+_LAW_OPTIONS = {
+    "hyperbolic": {"A": ("--A", PAPER_A), "B": ("--B", PAPER_B)},
+    "viscoelastic": {"f_th": ("--f-th", 1.0), "zbar": ("--zbar", 0.1), "k1": ("--k1", 0.1), "k2": ("--k2", 0.9),
+                     "eta_u": ("--eta-u", 1.0)},
+    "log": {"mu0": ("--mu0", 0.6), "b": ("--b", 0.015), "law_a": ("--law-a", 0.01), "v0": ("--v0", 1.0)},
+}
+
+
 def _check_law_options(args: argparse.Namespace) -> None:
-    """Options of the table law need --law table (else they would be ignored)."""
+    """Options of a law other than --law's are refused (else they would be ignored); the
+    chosen law's options that were not given take their defaults."""
+    for law, options in _LAW_OPTIONS.items():
+        for name, (option, default) in options.items():
+            if getattr(args, name, None) is None:
+                setattr(args, name, default)
+            elif law != args.law:
+                raise ValueError(f"{option} is for --law {law}; got --law {args.law} (give --law {law}, "
+                                 f"or drop {option})")
+    if args.mu_inf is not None and args.law != "hyperbolic":
+        raise ValueError(f"--mu-inf is for --law hyperbolic; got --law {args.law} (give --law hyperbolic, "
+                         "or drop --mu-inf)")
     if args.law != "table":
         for option, value in (("--table", args.table), ("--table-where", args.table_where)):
             if value is not None:
