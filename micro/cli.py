@@ -222,7 +222,8 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--no-growth-rate", dest="growth_rate", action="store_false",
                     help="skip the growth rate of the unstable mode (about 0.03 s per unstable V)")
     st.add_argument("--out", required=True,
-                    help="output CSV: k0,k1,k2,zbar,V,sigma,branching_ratio,stable,growth_rate,sigma_error,converged")
+                    help="output CSV: k0,k1,k2,zbar,V,sigma,branching_ratio,stable,growth_rate,sigma_error,converged,"
+                         "method (chain, fixed point or no dashpot)")
 
     s = sub.add_parser("sweep", help="stationary state for each drive velocity: one CSV row per V")
     _model_options(s)

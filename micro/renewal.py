@@ -27,8 +27,11 @@ Discretisation: Chebyshev collocation of the chain's expectation operator in x (
 moment method: the stationary measure, however narrow, need not be resolved), on an
 affine map, or a sinh map clustered at x = 0 on the scale (k0 + k1)/k2 when that is
 small, and composite Gauss-Legendre in z, graded towards z = 0.  The stationary weights are quadrature weights
-(they may be negative), not a density.  Deterministic jumps have no density: the chain is
-a 1-D map whose fixed point Newton's method finds (it reproduces Eq. (4)).
+(they may be negative), not a density; they are refined against the generator's own
+entries (near the identity, at large V or small k0 + k1, forming the system rounds them
+away), and sigma, b and G are renewal-reward ratios over the mean wait they give.
+Deterministic jumps have no density: the chain is a 1-D map whose fixed point is closed
+form (it reproduces Eq. (4)).
 
 Threads: the systems are small (32 to 384 unknowns) and solved thousands of times in a
 growth-rate root, where multithreaded BLAS gains nothing and its waiting threads spin
@@ -70,9 +73,10 @@ def _fractions(model: Model) -> tuple[float, float]:
     return (model.k0 + model.k1) / model.kappa, model.k2 / model.kappa
 
 
-def _stress(model: Model, V: float, mean_integral: float, zeta_bar: float) -> float:
-    """sigma = f_th - <delta>: the mean margin integral over the mean wait, in physical units."""
-    return model.f_th - model.kappa * (V / model.gamma) * mean_integral / zeta_bar
+def _stress(model: Model, V: float, mean_integral: float, mean_wait: float) -> float:
+    """sigma = f_th - <delta>: the mean margin integral over the mean wait (renewal-reward),
+    in physical units."""
+    return model.f_th - model.kappa * (V / model.gamma) * mean_integral / mean_wait
 
 
 def _check_velocities(V) -> np.ndarray:
@@ -180,6 +184,31 @@ class _Grid:
         return Dm - np.diag(Dm.sum(axis=1))
 
 
+#: Sweeps of iterative refinement of the stationary weights.
+REFINE_SWEEPS = 2
+
+
+def _stationary_weights(Q: np.ndarray) -> np.ndarray:
+    """The weights w with w Q = 0 and sum(w) = 1 (Q = M - I), as the nonsingular system
+    (1/n - Q)^T w = 1/n, refined against Q itself.
+
+    Near the identity (large V, small k0 + k1) the entries of Q are ~ alpha zeta_bar, far
+    below 1/n: forming 1/n - Q rounds them to a few digits (at k0 = 1e-4, (k1, k2) = (0, 1),
+    V = 1e7 one solve missed E_pi[t] = zeta_bar by 5e-6 relative, and b by 5e-6), and the LU's
+    backward error is amplified by 1 / (spectral gap) ~ 1 / (alpha zeta_bar).  Each sweep
+    solves for the correction with the same matrix but takes the residual
+    (1 - sum w)/n + Q^T w from Q's accurate entries; two sweeps bring E_pi[t] to zeta_bar
+    within ~1e-15 (docs/validation/micro_renewal.md, section 5).
+    """
+    n = Q.shape[0]
+    A_t = (1.0 / n - Q).T
+    w = np.linalg.solve(A_t, np.full(n, 1.0 / n))
+    for _ in range(REFINE_SWEEPS):
+        residual = (1.0 - w.sum()) / n + Q.T @ w
+        w = w + np.linalg.solve(A_t, residual)
+    return w
+
+
 @dataclass
 class _Chain:
     """The renewal chain of one (model, V) on one grid, with its stationary weights."""
@@ -203,11 +232,7 @@ class _Chain:
         zeta = model.gamma * quad.z / V
         Q, Et, EI, t, xp, L = RK.assemble(grid.x, grid.theta, grid.bw, zeta, quad.weight, alpha, beta,
                                           grid.c, grid.w, grid.mu, grid.nu, store)
-        n = grid.x.size
-        # stationary weights: w Q = 0 (Q = M - I), sum(w) = 1, as one nonsingular system
-        A = 1.0 / n - Q
-        weights = np.linalg.solve(A.T, np.full(n, 1.0 / n))
-        return cls(model, V, quad, grid, zeta, Q, Et, EI, weights,
+        return cls(model, V, quad, grid, zeta, Q, Et, EI, _stationary_weights(Q),
                    t if store else None, xp if store else None, L if store else None)
 
     @property
@@ -215,18 +240,28 @@ class _Chain:
         return float(self.quad.weight @ self.zeta)
 
     @property
+    def mean_wait(self) -> float:
+        """E_pi[t] from the computed weights (chain units; exactly zeta_bar for the exact pi)."""
+        return float(self.weights @ self.Et)
+
+    # sigma and b are renewal-reward ratios over the *computed* mean wait, not over its exact
+    # value zeta_bar: an error in where the weights put the measure is shared by the mean wait
+    # and cancels from the ratios up to O(zeta_bar) (docs/reference/micro_renewal.md, section
+    # 3; without the refined solve it was 5e-6 of the mean wait at V = 1e7)
+    @property
     def sigma(self) -> float:
-        return _stress(self.model, self.V, float(self.weights @ self.EI), self.zeta_bar)
+        return _stress(self.model, self.V, float(self.weights @ self.EI), self.mean_wait)
 
     @property
     def branching_ratio(self) -> float:
         m = self.model
-        return (m.k1 + m.k2) * float(self.weights @ (1.0 / (m.k0 + m.k1 + m.k2 * self.grid.x)))
+        crossings = float(self.weights @ (1.0 / (m.k0 + m.k1 + m.k2 * self.grid.x)))
+        return (m.k1 + m.k2) * crossings * self.zeta_bar / self.mean_wait
 
     @property
     def wait_error(self) -> float:
         """E_pi[T] V / zbar - 1, which the exact stationary measure makes 0."""
-        return float(self.weights @ self.Et) / self.zeta_bar - 1.0
+        return self.mean_wait / self.zeta_bar - 1.0
 
 
 #: Below this ratio (k0 + k1) / k2 the grid clusters at x = 0 on the scale (k0 + k1) / k2.
@@ -273,18 +308,15 @@ def _map_derivatives(x: float, zeta: float, alpha: float, beta: float) -> tuple[
 
 
 def _deterministic(model: Model, V: float) -> tuple[float, float, float, float]:
-    """Fixed point x* of the 1-D map x -> x'(x, zbar) by Newton: (x*, t*, sigma, b)."""
+    """Fixed point x* of the 1-D map x -> x'(x, zbar): (x*, t*, sigma, b).  Since
+    x' - x = (alpha/beta)(t - zeta), x' = x forces t = zeta, and (R1) then gives
+    x* = zeta / (e^zeta - 1) in closed form.  (A Newton iteration on the map, used before,
+    leaves the round-off of x' - x over 1 - dx'/dx ~ alpha zeta: 1e-7 in b at k0 = 1e-3,
+    (k1, k2) = (0, 1), V = 1e5.)"""
     alpha, beta = _fractions(model)
     zeta = model.gamma * model.jumps.mean / V
-    x = 1.0 / (1.0 + 0.5 * zeta)  # close to zeta / (e^zeta - 1), the exact fixed point
-    for _ in range(100):
-        _, xp, _, x_x = _map_derivatives(x, zeta, alpha, beta)
-        x_new = min(max(x - (xp - x) / (x_x - 1.0), 0.0), 1.0)
-        if abs(x_new - x) <= 1e-16 * max(x, 1e-300):
-            x = x_new
-            break
-        x = x_new
-    t = RK.waiting_time(zeta, x + zeta, alpha, beta)
+    x = zeta * math.exp(-zeta) / -math.expm1(-zeta)  # zeta / (e^zeta - 1), no overflow at large zeta
+    t = zeta
     sigma = _stress(model, V, RK.margin_integral(zeta, x + zeta, t, alpha, beta), zeta)
     b = (model.k1 + model.k2) / (model.k0 + model.k1 + model.k2 * x)
     return x, t, sigma, b
@@ -329,6 +361,7 @@ def _gain(model: Model, V: float, tol: float):
     Dtheta = grid.differentiation_matrix()
     dthdx = grid.dtheta_dx(chain.xp)
     wz = chain.quad.weight
+    rate = chain.zeta_bar / chain.mean_wait
 
     def gain(lam: complex) -> complex:
         A, A_dT, A_dx = _response_terms(alpha, beta, rho1, chain.t, chain.xp, D, lam)
@@ -336,7 +369,8 @@ def _gain(model: Model, V: float, tol: float):
         h = np.linalg.solve(np.eye(n) - M, np.ones(n, dtype=complex))  # discounted future jumps
         H = chain.L @ h
         H1 = (chain.L @ (Dtheta @ h)) * dthdx
-        return complex(chain.weights @ np.sum(wz[None, :] * (-lam * A_dT * H + A_dx * H1), axis=1))
+        # per jump, over the computed mean wait (r0 = 1 / E_pi[t]), as sigma and b are
+        return complex(chain.weights @ np.sum(wz[None, :] * (-lam * A_dT * H + A_dx * H1), axis=1)) * rate
 
     return gain
 
@@ -502,13 +536,18 @@ class SteadySliding:
     growth_rate : ndarray
         The rate of the unstable mode (1/time; NaN where stable or not asked for).
     sigma_error, branching_error : ndarray
-        The change of sigma and b from the previous grid.
+        The change of sigma and b from the previous grid, and at least their round-off
+        (8 ulp of ``f_th + |sigma|`` and of b).
     wait_error : ndarray
         The relative error of the mean waiting time against zbar / V.
     n_nodes : ndarray of int
         The grid used (0 without dashpot, 1 for deterministic jumps: closed forms).
     converged : ndarray of bool
         Whether the grid met ``tol``.
+    method : ndarray of str
+        What answered each V: ``'chain'`` (the collocated renewal chain),
+        ``'fixed point'`` (deterministic jumps: the chain's fixed point in closed form) or
+        ``'no dashpot'`` (k2 = 0: a renewal process in closed form).
     message : str
         ``'converged'``, or the velocities where it did not.
     """
@@ -524,6 +563,7 @@ class SteadySliding:
     wait_error: np.ndarray
     n_nodes: np.ndarray
     converged: np.ndarray
+    method: np.ndarray
     message: str = field(default="")
 
     def to_frame(self) -> pd.DataFrame:
@@ -534,6 +574,7 @@ class SteadySliding:
             "V": np.ravel(self.V), "sigma": np.ravel(self.sigma), "branching_ratio": np.ravel(self.branching_ratio),
             "stable": np.ravel(self.stable), "growth_rate": np.ravel(self.growth_rate),
             "sigma_error": np.ravel(self.sigma_error), "converged": np.ravel(self.converged),
+            "method": np.ravel(self.method),
         })
 
 
@@ -541,6 +582,13 @@ class SteadySliding:
 #: on sigma and b is of order k2 / kappa, and the chain's solve with it is singular
 #: (k2 = 2e-211 at k0 = 1: numpy.linalg.LinAlgError, found by tests/micro/test_properties.py).
 NO_DASHPOT = 1e-13
+
+
+#: Relative round-off below which no error estimate of sigma or b goes: 8 ulp of
+#: f_th + |sigma| and of b (where the grids agree to the last bit, the errors measured against
+#: the large-V expansion are up to 2.2 ulp of f_th + |sigma| and 6.1 ulp of b;
+#: docs/validation/micro_renewal.md, section 5).
+ROUNDOFF = 8.0 * np.finfo(float).eps
 
 
 #: Smallest relaxation per mean wait, gamma zbar / V, the chain resolves.
@@ -607,14 +655,17 @@ def steady_sliding(model: Model, V, *, tol: float = 1e-11, growth_rate: bool = T
     flat = v.ravel()
     out = {k: np.full(flat.size, math.nan) for k in ("sigma", "b", "lam", "err_s", "err_b", "wait", "n")}
     conv = np.ones(flat.size, dtype=bool)
+    method = np.full(flat.size, "chain", dtype=object)
     for k, Vk in enumerate(flat):
         if _no_dashpot(model):
+            method[k] = "no dashpot"
             # no relaxation: every margin renews with increments (k0 + k1) z at any V
             out["sigma"][k] = model.f_th - (model.k0 + model.k1) * model.jumps.mean_residual
             out["b"][k] = model.k1 / (model.k0 + model.k1)
             out["err_s"][k] = out["err_b"][k] = out["wait"][k] = 0.0
             out["n"][k] = 0
         elif model.jumps.kind == KIND_DETERMINISTIC:
+            method[k] = "fixed point"
             _, t, out["sigma"][k], out["b"][k] = _deterministic(model, float(Vk))
             out["err_s"][k] = out["err_b"][k] = 0.0
             out["wait"][k] = t / (model.gamma * model.jumps.mean / Vk) - 1.0
@@ -625,6 +676,10 @@ def steady_sliding(model: Model, V, *, tol: float = 1e-11, growth_rate: bool = T
             out["err_s"][k], out["err_b"][k], out["wait"][k] = err_s, err_b, chain.wait_error
             out["n"][k] = chain.grid.x.size
             conv[k] = ok
+        # no estimate below the round-off of the formulas themselves (the grids of a
+        # near-identity chain can agree to the last bit)
+        out["err_s"][k] = max(out["err_s"][k], ROUNDOFF * (abs(model.f_th) + abs(out["sigma"][k])))
+        out["err_b"][k] = max(out["err_b"][k], ROUNDOFF * out["b"][k])
         if growth_rate and out["b"][k] > 1.0:
             out["lam"][k] = _growth_rate(model, float(Vk), out["b"][k], max(tol, 1e-10))
     shape = v.shape
@@ -636,7 +691,7 @@ def steady_sliding(model: Model, V, *, tol: float = 1e-11, growth_rate: bool = T
         log.warning("micro.steady_sliding(k0=%g): %s", model.k0, message)
     r = lambda a: a.reshape(shape)  # noqa: E731
     return SteadySliding(model, v, r(out["sigma"]), r(out["b"]), r(stable), r(out["lam"]), r(out["err_s"]),
-                         r(out["err_b"]), r(out["wait"]), r(out["n"].astype(int)), r(conv), message)
+                         r(out["err_b"]), r(out["wait"]), r(out["n"].astype(int)), r(conv), r(method), message)
 
 
 def vc_small_k0(model: Model) -> float:

@@ -87,6 +87,7 @@ from scipy import integrate, optimize
 import micro
 
 __all__ = ["Resolution", "JumpLaw", "jump_law", "steady", "branching_ratio", "branching_excess", "critical_velocity",
+           "FastExpansion", "fast_expansion",
            "deterministic_steady", "deterministic_critical_velocity"]
 
 
@@ -419,7 +420,7 @@ def deterministic_steady(model: micro.Model, V: float) -> tuple[float, float]:
     al, be = (k0 + k1) / kappa, k2 / kappa
     gamma = k2 / model.eta_u
     zeta = gamma * model.jumps.zbar / V
-    xs = zeta / math.expm1(zeta)
+    xs = zeta * math.exp(-zeta) / -math.expm1(-zeta)  # zeta / (e^zeta - 1), no overflow at large zeta
     D = xs + zeta
     q = float(_one_minus_one_plus_t_exp(np.array([zeta]))[0])
     integral = 0.5 * al * zeta * zeta + be * D * q
@@ -436,3 +437,52 @@ def deterministic_critical_velocity(model: micro.Model) -> float:
     # s / (e^s - 1) = s e^-s / (1 - e^-s), decreasing from 1 (s -> 0) to 0
     zeta = optimize.brentq(lambda s: s * math.exp(-s) / -math.expm1(-s) - r, 1e-300, 1e3, xtol=1e-300, rtol=1e-15)
     return (model.k2 / model.eta_u) * model.jumps.zbar / zeta
+
+
+# ------------------------------------------------------------------------------ the large-V expansion
+@dataclass(frozen=True)
+class FastExpansion:
+    """sigma and b to O(V^-2): ``sigma_terms`` and ``b_terms`` are the V^0, V^-1 and V^-2
+    terms (their sums are ``sigma`` and ``b``); the remainder is O(V^-3)."""
+
+    sigma: float
+    b: float
+    sigma_terms: tuple
+    b_terms: tuple
+
+
+def fast_expansion(model: micro.Model, V: float) -> FastExpansion:
+    r"""Steady sliding at large V from the model's equations, not from any chain
+    (derivation: docs/reference/micro_renewal.md, section 6).
+
+    With eps = gamma / V (gamma = k2 / eta_u), R the equilibrium residual of g (density
+    (1 - G(r)) / zbar: <R^k> = <z^(k+1)> / ((k + 1) zbar)), Var(R) and mu3(R) its variance and
+    third central moment, and S = Var(z^2/2 - <R> z):
+
+        sigma = f_th - kappa <R> + k2 eps Var(R) + k2 eps^2 [alpha S / (2 zbar) - mu3(R)] + O(eps^3)
+        b     = b0 [1 + beta eps <R> + beta eps^2 (beta <R>^2 - Var(R))] + O(eps^3),  b0 = (k1 + k2)/kappa
+
+    (alpha = (k0 + k1)/kappa, beta = k2/kappa).  The moments of g come from quad on its
+    density (deterministic jumps: zbar^k).
+    """
+    if isinstance(model.jumps, micro.Deterministic):
+        zb = float(model.jumps.zbar)
+        m1, m2, m3, m4 = zb, zb**2, zb**3, zb**4
+    else:
+        law = jump_law(model.jumps)
+        scalar = lambda z: float(law.pdf(np.array([z]))[0])  # noqa: E731
+        m1, m2 = law.mean, law.second
+        m3 = _quad(lambda z: z**3 * scalar(z), 0.0, law.top, law.breaks)
+        m4 = _quad(lambda z: z**4 * scalar(z), 0.0, law.top, law.breaks)
+    k0, k1, k2 = model.k0, model.k1, model.k2
+    kappa = k0 + k1 + k2
+    alpha, beta = (k0 + k1) / kappa, k2 / kappa
+    eps = (k2 / model.eta_u) / float(V)
+    r1, r2, r3 = m2 / (2.0 * m1), m3 / (3.0 * m1), m4 / (4.0 * m1)  # <R>, <R^2>, <R^3>
+    var = r2 - r1 * r1
+    mu3 = r3 - 3.0 * r1 * r2 + 2.0 * r1**3
+    S = m4 / 4.0 - r1 * m3 + r1 * r1 * m2
+    sigma_terms = (model.f_th - kappa * r1, k2 * eps * var, k2 * eps**2 * (alpha * S / (2.0 * m1) - mu3))
+    b0 = (k1 + k2) / kappa
+    b_terms = (b0, b0 * beta * eps * r1, b0 * beta * eps**2 * (beta * r1 * r1 - var))
+    return FastExpansion(sum(sigma_terms), sum(b_terms), sigma_terms, b_terms)

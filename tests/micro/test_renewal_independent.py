@@ -11,7 +11,7 @@ deterministic jumps.
 
 Measured (2 cores, loaded): the reference moves by <= 1.1e-11 in V^c for k0 >= 1e-3 and by
 ~2e-10 at k0 = 1e-4 under refinement (b - 1 moves by ~2e-14 there and db/dlog V ~ k0/kappa),
-sigma by <= 1e-15; micro agrees to <= 2.4e-10 in V^c except where stated at the cases.
+sigma by <= 1e-15; micro agrees to <= 1.1e-10 in V^c, 4.4e-16 in sigma and 2.6e-14 in b (_tolerances).
 """
 from __future__ import annotations
 
@@ -144,18 +144,15 @@ def test_reference_critical_velocity_stops_moving_under_refinement(k0, k1, k2):
 
 # ------------------------------------------------------------------------------ micro against the reference
 def _tolerances(k0: float, k1: float) -> tuple[float, float, float]:
-    """(V^c relative, sigma relative, b absolute) allowed between micro and the reference."""
-    if k1 == 0.0 and k0 <= 1e-4:
-        # (k1, k2) = (0, 1), k0 = 1e-4: the chain's spectral gap is ~(k0/k2) gamma zbar / V^c ~ 1e-8
-        # and micro's grid stops at 384 nodes unconverged (it warns); docs/reference/micro_renewal.md
-        # documents 2e-5 in V^c.  Measured: 5.1e-6 in V^c, 1.6e-9 in sigma, 1.4e-8 in b.
-        return 2e-5, 5e-9, 5e-8
-    if k0 <= 1e-4 or (k1 == 0.0 and k0 <= 1e-3):
-        # micro's b has a round-off floor ~1e-12 (its own branching_error at V^c is 8e-13), and
-        # |db/dlog V| ~ k0/kappa: 1e-8 in V^c (its error estimate is 9.4e-9 and 9.5e-9 here).
-        # Measured: 2.2e-9 at (0.1, 0.9), k0 = 1e-4 and 3.4e-9 at (0, 1), k0 = 1e-3.
-        return 1e-8, 1e-9, 1e-9
-    return 1e-9, 1e-9, 1e-9
+    """(V^c relative, sigma relative, b absolute) allowed between micro and the reference.
+
+    Measured at every case (the slow one included): <= 1.1e-10 in V^c (micro's rtol is 1e-10,
+    the reference moves by 2e-10 under refinement at k0 = 1e-4), <= 4.4e-16 in sigma and
+    <= 2.6e-14 in b.  Before micro refined its stationary weights against Q (docs/reference/
+    micro_renewal.md, section 3), (k1, k2) = (0, 1) at k0 = 1e-4 needed 2e-5, 5e-9 and 5e-8
+    (the grid stopped at 384 nodes unconverged) and k0 <= 1e-4 or (0, 1) at 1e-3 needed 1e-8
+    in V^c (micro's b had a round-off floor ~1e-12 and |db/dlog V| ~ k0/kappa)."""
+    return 1e-9, 1e-12, 1e-12
 
 
 def _compare(model: micro.Model) -> None:
@@ -182,7 +179,7 @@ CASES = [pytest.param(k0, k1, k2, marks=[pytest.mark.slow] if (k1 == 0.0 and k0 
 @pytest.mark.parametrize("k0, k1, k2", CASES)
 def test_steady_sliding_and_critical_velocity_against_the_reference(k0, k1, k2):
     # the paper's five k0 at Fig. 5's four (k1, k2) sets (k0 >= k2: V^c = 0, and the steady
-    # branch is compared at V = 0.03 and 3).  (0, 1) at k0 = 1e-4 costs ~20 s in micro: slow
+    # branch is compared at V = 0.03 and 3).  (0, 1) at k0 = 1e-4 costs ~10 s in the reference: slow
     _compare(micro.Model(k0=k0, k1=k1, k2=k2))
 
 
@@ -226,21 +223,13 @@ def _deterministic_case(k0, k1, k2, tol_vc, tol_sigma, tol_b):
 @pytest.mark.parametrize("k0, k1, k2, tol_vc, tol_sigma, tol_b", [
     (0.1, 0.1, 0.9, 1e-9, 1e-12, 1e-12),
     (0.01, 0.9, 0.1, 1e-9, 1e-12, 1e-12),
-    # micro's b for deterministic jumps carries ~5e-11 of noise (its Newton fixed point;
-    # measured +8e-11, +2.3e-11, -3.5e-11 at V = 49.98332770, 780, 790 where the exact b - 1 is
-    # 1.5e-12, -5e-13, -2.5e-12 (mpmath agrees with the closed form to 1e-13)), and here
-    # |db/dlog V| ~ k0 = 1e-3: V^c is off by 4.5e-9 (it reports 1e-10).  The strict target is
-    # the xfail below.  Its sigma is off by 4.4e-12 and 4.8e-12 at V^c and 3 V^c (Eq. (4) in
-    # mpmath: the reference's closed form to 1e-16)
-    (1e-3, 0.0, 1.0, 1e-8, 1e-11, 2e-10),
+    # was a strict xfail at 1e-9: micro found the fixed point by Newton on the map, which left
+    # ~5e-11 of noise in b and 4.5e-9 in V^c here (|db/dlog V| ~ k0 = 1e-3).  The fixed point is
+    # now the closed form x* = zeta / (e^zeta - 1): measured 2e-12 in V^c (its rtol is 1e-10),
+    # sigma and b exact to the last bit at 0.5, 1 and 3 V^c
+    (1e-3, 0.0, 1.0, 1e-9, 1e-12, 1e-12),
 ])
 def test_deterministic_jumps_against_the_closed_forms(k0, k1, k2, tol_vc, tol_sigma, tol_b):
     # b = (k1 + k2)/(k0 + k1 + k2 x*), x* = zeta/(e^zeta - 1), and V^c = gamma zbar / zeta
-    # where x* = 1 - k0/k2 (a 1-D root); micro solves the map's fixed point by Newton
+    # where x* = 1 - k0/k2 (a 1-D root)
     _deterministic_case(k0, k1, k2, tol_vc, tol_sigma, tol_b)
-
-
-@pytest.mark.xfail(strict=True, reason="micro's deterministic fixed point leaves ~5e-11 noise in b: V^c off by "
-                                       "4.5e-9 at k0 = 1e-3, (k1, k2) = (0, 1)")
-def test_deterministic_critical_velocity_to_1e_9_at_small_k0():
-    _deterministic_case(1e-3, 0.0, 1.0, 1e-9, 1e-12, 1e-11)
