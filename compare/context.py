@@ -161,7 +161,7 @@ class Context:
 
     # -- micro, direct: V^c and the steady branch ------------------------------------------------
     def Vc(self, k0: float, k1: float | None = None, k2: float | None = None) -> float:
-        """Micro's exact V^c (0 when k0 >= k2: no stick-slip)."""
+        """Micro's exact V^c (NaN when k0 >= k2: no stick-slip)."""
         rec = self.run([VcTask(self.model(k0, k1, k2))], "micro Vc (direct)")[0]
         if rec.get("status") != "ok":
             raise RuntimeError(f"micro V^c at k0 = {k0:g} failed: {rec.get('error')}")
@@ -181,7 +181,7 @@ class Context:
         if reference is not None:
             return tuple(sig(v) for v in reference)
         vc = self.Vc(k0, k1, k2)
-        if vc == 0.0:
+        if not vc > 0.0:  # (NaN: no stick-slip)
             return tuple(sig(v) for v in np.geomspace(1e-3, 1e3, s.branch_points))
         hi = max(min(s.branch_span * vc, s.branch_V_max), 10 * vc)
         stable = vc * np.geomspace(1.0 + 1e-3, hi / vc, s.branch_points)
@@ -378,7 +378,7 @@ class Context:
         out = {}
         for k0, grp in b[b.role == "branch"].groupby("k0"):
             vc = float(grp.Vc.iloc[0])
-            if vc <= 0:
+            if not vc > 0:
                 continue
             lo, hi = vc * (1 - 1e-3), vc * (1 + 1e-3)
             a = grp[np.isclose(grp.V, lo, rtol=1e-12)]

@@ -340,7 +340,7 @@ def critical_velocity(
     Returns
     -------
     Critical
-        ``Vc = 0`` with status ``"no stick-slip"`` where steady sliding is stable at every
+        ``Vc = nan`` with status ``"no stick-slip"`` where steady sliding is stable at every
         V (``k0 >= k2``); ``inf`` with ``"above range"`` beyond ``V_max``.
     """
     _check_model(model)
@@ -364,8 +364,10 @@ def critical_velocity(
     renewal = opts.renewal if isinstance(opts, Auto) else opts
     Vc, error, status, message, evaluations = critical_velocity_renewal(model, V_min=V_min, V_max=V_max,
                                                                          tol=renewal.tol)
+    if status == "no stick-slip":
+        Vc = math.nan  # (no critical velocity: rsf's encoding of 'stable at every V' too)
     low, high = (Vc - error, Vc + error) if math.isfinite(Vc) and Vc > 0.0 else (
-        (0.0, V_min) if Vc == 0.0 else (V_max, math.inf))
+        (0.0, V_min) if status == "no stick-slip" else (V_max, math.inf))
     if status != "converged":
         log.info("micro.critical_velocity(k0=%g, k1=%g, k2=%g): %s", model.k0, model.k1, model.k2, message)
     return Critical(model, Vc, low, high, status, message, evaluations, method="renewal")

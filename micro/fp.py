@@ -495,7 +495,7 @@ def critical_velocity_fp(
     The regime is evaluated at ``V_guess``, then at velocities ``factor`` times smaller
     or larger (within ``[V_min, V_max]``) until it changes; the bracket is then halved
     geometrically until ``V_high / V_low - 1 <= rel_tol``.  If the
-    system is steady already at ``V_min`` (e.g. ``k0 >= k2``), ``Vc`` is reported as 0
+    system is steady already at ``V_min`` (e.g. ``k0 >= k2``), ``Vc`` is reported as NaN
     with status ``"no stick-slip"``; if it is stick-slip at ``V_max``, as ``inf`` with
     status ``"above range"``.
 
@@ -529,7 +529,7 @@ def critical_velocity_fp(
     """
     if model.k2 == 0.0 or model.k0 >= model.k2:
         # closed form: steady sliding is stable at every V, nothing to bisect
-        return _reported(Critical(model, 0.0, 0.0, V_min, "no stick-slip",
+        return _reported(Critical(model, math.nan, 0.0, V_min, "no stick-slip",
                                   f"k0 = {model.k0:g} >= k2 = {model.k2:g}: steady sliding is stable at every V "
                                   "(branching ratio below 1), no stick-slip", []))
     evaluations: list[dict] = []
@@ -595,7 +595,7 @@ def critical_velocity_fp(
     while True:
         if steady:
             if V <= V_min:
-                return _reported(Critical(model, 0.0, 0.0, V_min, "no stick-slip",
+                return _reported(Critical(model, math.nan, 0.0, V_min, "no stick-slip",
                                           f"steady already at V_min = {V_min:g}", evaluations))
             V = max(V / factor, V_min)
             if regime(V) != "steady":

@@ -297,8 +297,9 @@ class Critical:
     model : Model
         The model.
     Vc : float
-        V^c: the root of b(V) = 1, or the geometric mean of the bisection's bracket; 0
-        with status ``"no stick-slip"``, ``inf`` with ``"above range"``.
+        V^c: the root of b(V) = 1, or the geometric mean of the bisection's bracket; NaN
+        with status ``"no stick-slip"`` (there is no critical velocity; rsf's encoding of
+        "stable at every V" too), ``inf`` with ``"above range"``.
     V_low : float
         Below V^c (stick-slip): ``Vc`` minus its error, or the bracket's lower end; 0
         with ``"no stick-slip"``, ``V_max`` with ``"above range"``.

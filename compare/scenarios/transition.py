@@ -65,7 +65,7 @@ def _cycle_tasks(ctx: Context) -> list[StationaryTask]:
     """The transition's cycles by micro's default (``cycle_method``), one per distance."""
     s = ctx.s
     vc = ctx.Vc(s.hopf_k0)
-    if vc <= 0:
+    if not vc > 0:  # (NaN: no stick-slip)
         return []
     return [ctx.cycle_task(s.hopf_k0, sig(vc * (1 - d))) for d in s.hopf_distances]
 
@@ -73,7 +73,7 @@ def _cycle_tasks(ctx: Context) -> list[StationaryTask]:
 def _nblock_tasks(ctx: Context) -> list[NBlockTask]:
     s = ctx.s
     vc = ctx.Vc(s.hopf_k0)
-    if vc <= 0:
+    if not vc > 0:  # (NaN: no stick-slip)
         return []
     return [NBlockTask(ctx.model(s.hopf_k0), sig(vc * (1 - d)), int(N)) for N in s.nblock_N
             for d in s.nblock_distances]
