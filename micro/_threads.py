@@ -32,6 +32,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
+import sys
 import threading
 import time
 from typing import Callable, Iterator, TypeVar
@@ -48,18 +49,21 @@ SAMPLE_SECONDS = 0.1
 _blas_lock = threading.Lock()
 _blas_depth = 0
 _blas_limiter = None
-_controller: tuple[int, object] | None = None  # (pid, threadpoolctl.ThreadpoolController)
+_controller: tuple[int, int, object] | None = None  # (pid, modules imported, ThreadpoolController)
 
 
 def _blas_controller():
-    """One ThreadpoolController per process (building one scans the loaded libraries,
-    about 3 ms; limiting through it about 0.05 ms)."""
+    """A ThreadpoolController of the libraries loaded now (building one scans them, about
+    3 ms; limiting through it about 0.05 ms): one per process, built again after new
+    modules were imported, since an import can load another BLAS (measured: a library
+    loaded after the first controller ran on 2 threads inside :func:`single_blas_thread`)."""
     global _controller
-    if _controller is None or _controller[0] != os.getpid():
+    here = (os.getpid(), len(sys.modules))
+    if _controller is None or _controller[:2] != here:
         from threadpoolctl import ThreadpoolController
 
-        _controller = (os.getpid(), ThreadpoolController())
-    return _controller[1]
+        _controller = (*here, ThreadpoolController())
+    return _controller[2]
 
 
 @contextlib.contextmanager
