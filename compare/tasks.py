@@ -611,4 +611,13 @@ def warm_up() -> float:
     model = micro.Model(k0=0.5)
     micro.simulate(model, 5.0, duration=0.5, numerics=micro.Numerics(eps=model.kappa * model.zbar / 4.0))
     micro.steady_sliding(micro.Model(k0=0.1), [0.5, 2.0], warn=False)
+    # the cohort method's and the N-block's kernels too: compiled once here (the parent
+    # fills numba's disk cache before the pool starts), not by every worker at its first
+    # cycle at once
+    coarse = micro.Model(k0=0.3)
+    micro.stationary(coarse, 0.1, method=micro.Cohort(dt=0.1, h=coarse.kappa * coarse.zbar / 2.0, tol=1e-2,
+                                                      max_iter=4), warn=False)
+    from micro.nblock import simulate_nblock
+
+    simulate_nblock(coarse, 0.1, 64, t_max=1.0)
     return time.perf_counter() - start
