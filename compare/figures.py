@@ -275,7 +275,7 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     if lo < NEAR_VC:
         keep(ax.axvspan(lo, min(NEAR_VC, hi), color="0.5", alpha=0.1, lw=0),
              f"d < {NEAR_VC:g}: micro's law not settled (the cohort's error not known)")
-    ax.text(0.02, 0.97, "micro: no asymptote derived yet", transform=ax.transAxes, ha="left", va="top",
+    ax.text(0.02, 0.97, "micro: no single power law; crossover at d ~ k0/k2", transform=ax.transAxes, ha="left", va="top",
             fontsize=8, color="C1")
     ax.set_xlabel("d = (V^c - V) / V^c (each model's own exact V^c)")
     ax.set_ylabel("sigma_max - sigma_min")

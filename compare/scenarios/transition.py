@@ -266,8 +266,12 @@ def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
         how = ("the cohort method" if r.method == "cohort" else f"the N-block at N = {r.resolution:.0f}"
                if r.method == "N-block" else f"the {r.method} at {_resolution(r, s)}")
         said.append(f"{_beta(r)} by {how} ({int(r.n_points)} points)")
-    out.append("In micro the amplitude is set by the size of its shocks, and no asymptotic law for it is derived "
-               "yet" + (": fitted, " + "; ".join(said) if said else "; no amplitude law could be fitted") + ".")
+    out.append("In micro the amplitude is set by the size of its shocks, and it has no single power law: while "
+               "shocks are total it depends on k0 V alone and is about linear in d (derived up to a measured "
+               "memory factor of 0.72-0.92), and shocks stop being total below a crossover at d of about k0/k2, "
+               "whose law is not derived (docs/reference/micro_transition.md; a single power law is rejected at "
+               "k0 = 0.1 and 0.01)" + (": fitted, " + "; ".join(said) if said else "; no amplitude law could be "
+                                       "fitted") + ".")
     if micro_div and rs_div:
         out.append("An exponent near 1/2 is therefore no evidence of a Hopf bifurcation.")
     nb = mf[mf.method == "N-block"] if len(mf) else mf

@@ -143,7 +143,7 @@ def test_transition_verdict_is_one_paragraph_on_both_sides(rep):
     cohort = rep["hopf_fit"].set_index("method").loc["cohort"]
     for part in ("same singular way", "c0 d^(1/2) (1 + c2 d)", f"c0 = {law['c0']:.4g}",
                  f"beta = {cohort.beta:.2f} (95 % CI {cohort.beta_low:.2f} to {cohort.beta_high:.2f})",
-                 "no asymptotic law for it is derived yet", "not yet settled below d = 0.2"):
+                 "it has no single power law", "crossover at d of about k0/k2", "not yet settled below d = 0.2"):
         assert part in text, part
 
 
