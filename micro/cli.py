@@ -14,6 +14,7 @@ import argparse
 import contextlib
 import logging
 import math
+import re
 import os
 import sys
 import tempfile
@@ -182,9 +183,22 @@ def _refuse(args, flags, why: str) -> None:
             raise ValueError(f"--{name.replace('_', '-')} {why}")
 
 
+#: The model's parameter names and the flags that set them (for the messages).
+_FLAGS = {"k0": "--k0", "k1": "--k1", "k2": "--k2", "zbar": "--zbar", "eta_u": "--eta-u", "f_th": "--f-th"}
+
+
 def _model(args, k0: float) -> Model:
-    jumps = Exponential(args.zbar, 10.0) if args.dist == "exp" else Deterministic(args.zbar)
-    return Model(k0=k0, k1=args.k1, k2=args.k2, eta_u=args.eta_u, f_th=args.f_th, jumps=jumps)
+    try:
+        jumps = Exponential(args.zbar, 10.0) if args.dist == "exp" else Deterministic(args.zbar)
+        return Model(k0=k0, k1=args.k1, k2=args.k2, eta_u=args.eta_u, f_th=args.f_th, jumps=jumps)
+    except ValueError as exc:  # (name the flag the user typed: "zbar must be ..." -> "--zbar must be ...")
+        text = str(exc)
+        if text.startswith("cutoff"):  # (the CLI's exponential jumps are cut at 10)
+            raise ValueError(f"--zbar must be below the exponential jumps' cutoff 10, got {args.zbar:g}") from None
+        name = re.match(r"[A-Za-z_][A-Za-z0-9_]*", text)
+        if name and name.group(0) in _FLAGS:
+            raise ValueError(_FLAGS[name.group(0)] + text[name.end():]) from None
+        raise
 
 
 def _fp_options(args) -> tuple[FP, Convergence]:
