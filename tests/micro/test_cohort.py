@@ -129,7 +129,8 @@ def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
     assert seen["warm"] > 20 and seen["shocks"] == 2
 
 
-@pytest.mark.parametrize("coarse", [True, False])
+@pytest.mark.parametrize("coarse", [True, pytest.param(False, marks=pytest.mark.slow)])  # (18 s: the default run
+# keeps the start from a coarse run, the default path)
 def test_a_short_loading_phase_gets_its_steps_from_the_cycle_not_from_the_transient(coarse):
     # k0 = 0.3, 0.95 V^c: the transient's loading phases are shorter (0.16) than the
     # cycle's (0.25).  The step must be the cycle's dt T / SHORT_PHASE, whatever phase the

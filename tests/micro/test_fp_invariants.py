@@ -133,6 +133,7 @@ def test_an_unconverged_stick_slip_transient_is_labelled_stick_slip():
     assert "towards a cycle" in res.message or "persists" in res.message
 
 
+@pytest.mark.slow  # (15 s under load; steady sliding is the renewal chain's by default)
 def test_steady_at_k0_001_V_1000_and_the_grids_oscillation_there_is_flagged():
     # The physics: k0 = 0.01, V = 1000 is 125 V^c, where steady sliding is linearly
     # stable (branching ratio 0.990 < 1: k0 D_c is small, the margin to V^c is not) and

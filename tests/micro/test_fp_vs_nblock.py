@@ -67,6 +67,7 @@ def _check_cycle(eps, n_blocks, coarse_ratio=2.0, share=1.0):
     assert fine.period == pytest.approx(ref.period, abs=4.0 * ref.period_stderr + 0.02 * ref.period)
 
 
+@pytest.mark.slow  # (12 s under load; steady sliding is the renewal chain's by default, checked by default against an independent reference and a Monte Carlo)
 def test_steady_sliding_agrees_with_nblock():
     # k0 = 0.3, V = 0.4 (about 2 V^c): velocity weakening 0.0154; at N = 2e4 the N-block's
     # tolerance is 2.6e-4 (1.7 %; its error 2.4e-5 measured)
