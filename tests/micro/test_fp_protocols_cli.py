@@ -40,7 +40,7 @@ def _cli(*args, cwd):
 
 def test_cli_sweep_and_run_write_the_documented_columns(tmp_path):
     out = tmp_path / "sweep.csv"
-    res = _cli("sweep", "--k0", "0.1", "--V", "0.05,2", "--out", str(out), cwd=tmp_path)
+    res = _cli("sweep", "--k0", "0.1", "--V", "0.3,2", "--out", str(out), cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     table = pd.read_csv(out)
     for col in "k0,k1,k2,zbar,V,method,regime,sigma_max,sigma_min,sigma_mean,discretisation_error".split(","):
