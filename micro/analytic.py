@@ -42,6 +42,23 @@ def sigma_deterministic_steady(model: Model, velocity: float) -> float:
 
     It assumes steady sliding (each block jumps every :math:`\bar z / V`); it uses the mean of
     ``model.jumps`` as :math:`\bar z` and is exact only for :class:`Deterministic` jumps.
+
+    Parameters
+    ----------
+    model : Model
+        The model (its jumps' mean is :math:`\bar z`).
+    velocity : float
+        The drive velocity V >= 0.
+
+    Returns
+    -------
+    float
+        The stationary stress of Eq. (4).
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`Model` or ``velocity`` is not a finite number >= 0.
     """
     _check_model(model)
     v = _check_float("velocity", velocity, low=0.0)
@@ -87,6 +104,24 @@ def sigma_fast_limit(model: Model, velocity: float | None = None) -> float:
     which reweights the residual R (whose variance is :math:`\bar z^2/12` for deterministic
     g, reproducing the large-V expansion of Eq. (4), and :math:`\approx \bar z^2` for
     exponential g). Valid for :math:`V \gg \gamma \bar z`.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    velocity : float, optional
+        The drive velocity V > 0 for the first correction; None (default) gives the
+        V -> infinity limit.
+
+    Returns
+    -------
+    float
+        The stress at V -> infinity, or with its 1/V correction.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`Model` or ``velocity`` is not a finite number > 0.
     """
     _check_model(model)
     sigma = model.f_th - model.kappa * model.jumps.mean_residual
@@ -105,6 +140,23 @@ def sigma_slow_limit(model: Model, velocity: float = 0.0) -> float:
     increments :math:`(k_0+k_1) z`; a block jumps when the common relaxed signal lags
     :math:`\bar h` by :math:`V/\gamma`, i.e. with relaxed margin :math:`k_2 V/\gamma = \eta_u V`.
     Eq. (5) is the deterministic case at V = 0.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    velocity : float, optional
+        The drive velocity V >= 0 (default 0: the V -> 0 limit).
+
+    Returns
+    -------
+    float
+        The stress to first order in V.
+
+    Raises
+    ------
+    ValueError
+        If ``model`` is not a :class:`Model` or ``velocity`` is not a finite number >= 0.
     """
     _check_model(model)
     v = _check_float("velocity", velocity, low=0.0)
