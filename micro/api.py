@@ -30,9 +30,9 @@ import pandas as pd
 
 from . import fp
 from .analytic import sigma_fast_limit
-from .cohort import GRADED_MAX, cycle_cohorts
+from .cohort import GRADED_MAX, cycle_cohorts, not_applicable as cohort_not_applicable
 from .methods import FP, Auto, Cohort, Convergence, Method, Renewal, check_velocity, resolve
-from .params import KIND_EXPONENTIAL, Model
+from .params import Model
 from .protocols import Drive
 from .renewal import critical_velocity_renewal, steady_sliding
 from .results import Critical, CycleFixedPoint, Run, Stationary
@@ -164,9 +164,9 @@ def _direct_then_cycle(model: Model, V: float, opts: Auto, numerics: FP | None, 
     direct = _renewal_row(model, V, opts.renewal)
     if direct is not None:
         return direct
-    if model.jumps.kind != KIND_EXPONENTIAL:
-        return _fp_row(model, V, numerics, convergence, warn,
-                       why="the cohort method needs exponential jumps")
+    why = cohort_not_applicable(model)
+    if why:
+        return _fp_row(model, V, numerics, convergence, warn, why=why.split(" (")[0])
     row = _cohort_row(model, V, opts.cohort, warn, start)
     if row is not None:
         return row

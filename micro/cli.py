@@ -303,8 +303,9 @@ def _options(args, models: list[Model]):
         if args.method not in ("auto", "cohort", "fp"):
             raise ValueError(f"--method must be auto, cohort or fp, got {args.method!r}")
         cohort_used = args.method != "fp"
-        # the Fokker-Planck equation answers a sweep row of auto or cohort only for non-exponential jumps
-        fp_used = args.method == "fp" or args.dist != "exp"
+        # the Fokker-Planck equation answers a sweep row of auto or cohort only for jumps the
+        # cohort method does not take: not exponential, or cut at 10 < 30 zbar
+        fp_used = args.method == "fp" or args.dist != "exp" or 10.0 < 30.0 * args.zbar
     if not cohort_used:
         how = f" --method {args.method}" if getattr(args, "method", None) else ""
         _refuse(args, COHORT_FLAGS, f"sets the cohort method, which `micro {args.command}{how}` does not use")

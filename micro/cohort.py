@@ -813,6 +813,24 @@ def _estimate(a: np.ndarray, tol: float) -> tuple[np.ndarray, list[str], np.ndar
     return errors, how, best, rho
 
 
+#: The cohort method takes an Exponential whose cutoff removes at most this fraction of the
+#: jumps (exp(-cutoff / zbar) <= 1e-13, cutoff >= 30 zbar): a jumped block's margin is
+#: then Exp(kappa zbar) to double precision.  A closer cutoff changes the margins at order
+#: exp(-cutoff / zbar) (cutoff = 3 zbar: sigma_min 1.3e-2 off, tests/micro/test_cohort_parameters.py).
+CUTOFF_TAIL = 1e-13
+
+
+def not_applicable(model: Model) -> str:
+    """Why the cohort method does not apply to ``model``'s jumps ("" if it does)."""
+    jumps = model.jumps
+    if jumps.kind != KIND_EXPONENTIAL:
+        return "the cohort method needs exponential jumps (a jumped block's margin is then Exp(kappa zbar))"
+    if math.exp(-jumps.cutoff / jumps.zbar) > CUTOFF_TAIL:
+        return (f"the cohort method needs exponential jumps whose cutoff removes a negligible tail "
+                f"(cutoff >= 30 zbar = {30 * jumps.zbar:g}, got {jumps.cutoff:g})")
+    return ""
+
+
 def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None = None, tol: float = 1e-5,
                   max_iter: int = 200, start=None) -> CycleFixedPoint:
     """The stick-slip limit cycle at drive velocity ``V``, by the cohort method (module
@@ -840,8 +858,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     ``eps`` in the result is ``h``.
     """
     begin = time.perf_counter()
-    if model.jumps.kind != KIND_EXPONENTIAL:
-        raise ValueError("the cohort method needs exponential jumps (a jumped block's margin is then Exp(kappa zbar))")
+    why = not_applicable(model)
+    if why:
+        raise ValueError(why)
     h = model.kappa * model.zbar / 20.0 if h is None else h
     for name, value in (("V", V), ("dt", dt), ("h", h), ("tol", tol)):
         if not (math.isfinite(value) and value > 0.0):

@@ -68,6 +68,7 @@ def test_small_velocity_stress_with_its_eta_u_V_term():
     assert _steady(STIFF, V, 0.025) == pytest.approx(exact, abs=1e-3)
 
 
+@pytest.mark.slow  # (19 s under load; the FP is the fallback: its eps refinement stays in the default run above)
 def test_converges_as_eps_shrinks():
     # k0 = 0.1, V = 2 against the exact stress of the renewal chain (0.893759123072792,
     # tests/micro/test_renewal.py): errors -5.8e-5, -2.8e-5, -1.6e-5 at eps = 0.02, 0.01,
