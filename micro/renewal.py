@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import logging
 import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -79,11 +80,23 @@ def _stress(model: Model, V: float, mean_integral: float, mean_wait: float) -> f
     return model.f_th - model.kappa * (V / model.gamma) * mean_integral / mean_wait
 
 
+def _is_number(x) -> bool:
+    """A real number, not a bool (an int to Python) or a string (float('1') would take it)."""
+    return not isinstance(x, (bool, np.bool_, str, bytes)) and isinstance(x, (numbers.Real, np.number))
+
+
 def _check_velocities(V) -> np.ndarray:
+    """``V`` (a number or an array of numbers, strictly: no strings, no bools) as floats in
+    the velocity range, or one ValueError."""
+    shown = repr(V) if len(repr(V)) <= 60 else repr(V)[:57] + "..."
     try:
-        v = np.asarray(V, dtype=float)
+        raw = np.asarray(V)
+        ok = raw.dtype.kind in "iuf" or (raw.dtype.kind == "O" and all(_is_number(x) for x in raw.ravel()))
+        if not ok:
+            raise TypeError
+        v = raw.astype(float)
     except (TypeError, ValueError):
-        raise ValueError(f"V must be a number or an array of numbers, got {V!r}") from None
+        raise ValueError(f"V must be a number or an array of numbers, got {shown}") from None
     bad = ~(np.isfinite(v) & (v >= V_RANGE[0]) & (v <= V_RANGE[1]))
     if np.any(bad):
         raise ValueError(f"V must be finite and in [{V_RANGE[0]:g}, {V_RANGE[1]:g}], got {float(v[bad].ravel()[0])!r}")

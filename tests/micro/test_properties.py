@@ -60,6 +60,18 @@ def test_a_bad_jump_distribution_is_one_error_naming_zbar(zbar):
             make()
 
 
+@pytest.mark.parametrize("V", ["1", b"1", True, np.True_, ["1", "2"], [1.0, "2"], np.array([True, False]),
+                               np.array(["1"]), None])
+def test_the_velocity_of_the_steady_branch_is_a_number_not_a_string(V):
+    # issue 39 row 12 (strict types): steady_sliding(m, '1') was taken as V = 1
+    for call in (micro.steady_sliding, micro.unstable_mode_count):
+        with pytest.raises(ValueError, match=r"^V must be a number or an array of numbers, got ") as info:
+            call(micro.Model(k0=0.1), V)
+        assert "\n" not in str(info.value)
+    branch = micro.steady_sliding(micro.Model(k0=0.1), np.array([1, 2.0], dtype=object))
+    assert branch.sigma.shape == (2,) and np.all(np.isfinite(branch.sigma))
+
+
 @QUICK
 @given(name=st.sampled_from(["dt", "h", "tol", "max_iter"]), value=st.one_of(NOT_A_NUMBER, NEGATIVE))
 def test_bad_cohort_options_are_one_error_naming_them(name, value):
