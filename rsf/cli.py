@@ -42,6 +42,9 @@ logger = logging.getLogger(__name__)
 #: T_END_MAX is rsf.params.T_END_MAX, the bound of rsf.simulate's t_end.
 K0_MAX, V_MAX, N_V_MAX = 1e3, 1e7, 10_000
 
+#: rsf run's default output step: --t-end / OUT_ROWS between events (--out-dt).
+OUT_ROWS = 10_000
+
 
 def _floats(text: str) -> list[float]:
     """Every item of a comma-separated list, each a finite number (no empty items)."""
@@ -167,7 +170,8 @@ def _add_model_options(p: argparse.ArgumentParser, k0_list: bool = False) -> Non
     t = p.add_argument_group("table law")
     t.add_argument("--table", default=None,
                    help="CSV file with a velocity and a friction column (with --law table only; "
-                        "outside its velocities the law is held flat, with a warning)")
+                        "outside its velocities the law is held flat: a warning names the velocity, a "
+                        "driving velocity or the state velocity Dc/theta a run reaches)")
     t.add_argument("--table-v-column", default="V", help="velocity column (default V)")
     t.add_argument("--table-mu-column", default="sigma", help="friction column (default sigma)")
     t.add_argument("--table-where", default=None,
@@ -307,7 +311,7 @@ def _options(args: argparse.Namespace) -> SolverOptions:
                              v_max=args.v_max, max_rhs_evals=args.max_rhs_evals)
 
 
-def _write(frame, out: str | None) -> None:
+def _write(frame, out: str | None, note: str = "") -> None:
     """To standard output, or atomically (:func:`rsf.results.write_atomically`: the umask,
     an existing file's mode and a symbolic link are respected).  The count of rows goes to
     standard error, so that standard output carries nothing but data."""
@@ -320,7 +324,7 @@ def _write(frame, out: str | None) -> None:
             frame.to_csv(f, index=False)
 
     write_atomically(out, fill)
-    print(f"wrote {len(frame)} rows to {out}", file=sys.stderr)
+    print(f"wrote {len(frame)} rows to {out}{note}", file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -373,7 +377,15 @@ def build_parser() -> argparse.ArgumentParser:
                     help="output times t1,t2,... (strictly increasing, in [0, t-end]): samples "
                          "exactly there instead of at every integrator step")
     pr.add_argument("--t-eval-n", type=int, default=None,
-                    help="output at N equally spaced times from 0 to t-end")
+                    help="output at N equally spaced times from 0 to t-end, N in [2, 10000000]")
+    pr.add_argument("--out-dt", type=float, default=None,
+                    help=f"without --t-eval or --t-eval-n the rows are the integrator's own steps "
+                         f"(exact, no interpolation), at most one per OUT_DT of time besides the "
+                         f"rows at events (a slip's two rows, the extrema of the spring force), so at most "
+                         f"about t-end/OUT_DT + 2 per event; in [0, t-end]; 0: every step. "
+                         f"Default: every step if there are at most {OUT_ROWS}, else OUT_DT = "
+                         f"t-end/{OUT_ROWS} (a fast cycle at rtol 1e-10 takes hundreds of steps, "
+                         f"and a long run 100000s)")
     _add_model_options(pr)
     _add_solver_options(pr)
     return parser
@@ -463,6 +475,19 @@ def _history(path: str, t_end: float) -> Protocol:
         logger.warning("--history ends at t = %g, before --t-end = %g: the driving holds its last "
                        "velocity, V = %g, from there on", t[-1], t_end, V[-1])
     return Protocol.sampled(t, V)
+
+
+def _out_dt(args: argparse.Namespace, steps: int) -> float:
+    """The smallest time between two rows of ``rsf run`` apart from events (``--out-dt``;
+    by default 0 for a run of at most ``OUT_ROWS`` steps, else ``--t-end / OUT_ROWS``); 0
+    with ``--t-eval`` or ``--t-eval-n``."""
+    if args.out_dt is None:
+        if args.t_eval is not None or args.t_eval_n is not None or steps <= OUT_ROWS:
+            return 0.0
+        return args.t_end / OUT_ROWS
+    if args.t_eval is not None or args.t_eval_n is not None:
+        raise ValueError("give at most one of --t-eval, --t-eval-n and --out-dt")
+    return _number("--out-dt", args.out_dt, 0.0, args.t_end)
 
 
 def _t_eval(args: argparse.Namespace) -> np.ndarray | None:
@@ -559,11 +584,17 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 0
         V, protocol = _protocol(args)
         t_eval = _t_eval(args)
+        _out_dt(args, 0)
         if isinstance(model.law, TabulatedLaw):
             model.law.check_velocities(_driving_velocities(V, protocol), "the driving velocity V")
         traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
                         t_eval=t_eval)
-        _write(traj.to_frame(), args.out)
+        steps = traj.t.size
+        out_dt = _out_dt(args, steps)
+        traj = traj.thinned(out_dt)
+        note = "" if traj.t.size == steps else (f" (of {steps} integrator steps: one row per --out-dt = "
+                                                f"{out_dt:g} between events; --out-dt 0 writes them all)")
+        _write(traj.to_frame(), args.out, note)
         if args.events:
             _write(traj.events_frame(), args.events)
         if not traj.success:

@@ -211,6 +211,51 @@ class Trajectory:
         """Columns t, kind, sigma, theta, x."""
         return _events_frame(self.events)
 
+    def thinned(self, dt: float) -> Trajectory:
+        """The same run with at most one sample per ``dt`` of time, except at events.
+
+        The first and last samples, every sample at an event's time (a slip's two samples,
+        the extrema of sigma, the changes of phase) and every sample that shares its time
+        with a neighbour are kept; of the others, a sample is kept when it lies at least
+        ``dt`` after the last one kept.  So a run of ``t_end`` keeps at most
+        ``t_end / dt + 1`` samples besides those at events, however many steps the
+        integrator took.  ``dt = 0`` keeps every sample.  The samples kept are exact (no
+        interpolation); the events are unchanged.
+
+        Parameters
+        ----------
+        dt : float
+            Smallest time between two samples kept apart from events, >= 0.
+
+        Returns
+        -------
+        Trajectory
+            A new trajectory (this one if nothing is dropped).
+        """
+        dt = float(dt)
+        if not (math.isfinite(dt) and dt >= 0.0):
+            raise ValueError(f"dt must be a finite number >= 0, got {dt:g}")
+        n = self.t.size
+        if dt == 0.0 or n <= 2:
+            return self
+        t = self.t
+        forced = np.isin(t, np.array([e.t for e in self.events], dtype=float))
+        forced[[0, -1]] = True
+        same = np.diff(t) == 0.0
+        forced[:-1] |= same
+        forced[1:] |= same
+        keep = forced.copy()
+        last = -math.inf
+        for i in range(n):
+            if forced[i] or t[i] - last >= dt:
+                keep[i] = True
+                last = t[i]
+        if keep.all():
+            return self
+        return Trajectory(t=t[keep], x=self.x[keep], sigma=self.sigma[keep], theta=self.theta[keep],
+                          v=self.v[keep], events=self.events, status=self.status, message=self.message,
+                          params=self.params, theta2=None if self.theta2 is None else self.theta2[keep])
+
 
 @dataclass
 class CycleResult:

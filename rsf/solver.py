@@ -21,6 +21,7 @@ import numpy as np
 from ._validation import positive
 from .cycles import CycleSearch
 from .engines import Stop, make_engine
+from .laws import TabulatedLaw
 from .params import T_END_MAX, InitialState, Protocol, SolverOptions, SpringSlider
 from .results import STATUS_MESSAGES, CycleResult, Status, SweepResult, Trajectory
 
@@ -41,6 +42,22 @@ def _protocol_from(V: float | None, protocol: Protocol | None) -> Protocol:
     if not isinstance(protocol, Protocol):
         raise ValueError(f"protocol must be an rsf.Protocol, got {protocol!r}")
     return protocol
+
+
+def _check_table(model: SpringSlider, velocities, thetas, where: str) -> None:
+    """A :class:`~rsf.laws.TabulatedLaw` is evaluated at the state velocity
+    :math:`D_c/\theta` (steady sliding: the driving velocity); warn (once per law, naming
+    the table's range and the velocity) if ``velocities`` or the state velocities of
+    ``thetas`` leave the table, where the law is held flat."""
+    if not isinstance(model.law, TabulatedLaw):
+        return
+    if velocities is not None:
+        model.law.check_velocities(velocities, f"{where}: the driving velocity V")
+    theta = np.asarray(thetas, dtype=float).ravel()
+    theta = theta[np.isfinite(theta) & (theta > 0.0)]
+    if theta.size:
+        model.law.check_velocities(model.Dc / np.array([theta.max(), theta.min()]),
+                                   f"{where}: the state velocity Dc/theta")
 
 
 def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
@@ -138,6 +155,9 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     if status < 0:
         logger.warning("simulate: %s", message)
     theta2 = engine.samples.theta2_array() if model.second_state is not None else None
+    velocities = np.asarray(protocol.velocities, dtype=float)
+    _check_table(model, velocities[velocities > 0.0], np.concatenate([theta, [e.theta for e in engine.events]]),
+                 "simulate")
     return Trajectory(t=t, x=x, sigma=sigma, theta=theta, v=v, theta2=theta2, events=engine.events,
                       status=status, message=message, params=model.describe())
 
@@ -224,6 +244,8 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
     status = search.status
     run_time = time.perf_counter() - started
     message = STATUS_MESSAGES[status] + (f" ({search.detail})" if search.detail else "")
+    _check_table(model, [V], [e.theta for e in (search.result.events if search.result else ())],
+                 f"limit_cycle(V={V:g})")
     if status == Status.STEADY:
         sigma_ss = model.sigma_steady(V)
         return CycleResult(V=V, regime="steady", sigma_max=sigma_ss, sigma_min=sigma_ss,

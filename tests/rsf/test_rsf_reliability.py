@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import io
 import logging
-import os
 import re
 
 import numpy as np
@@ -163,6 +162,35 @@ def test_table_law_outside_its_velocities_warns_once(table, tmp_path, caplog):
     assert not [r for r in caplog.records if "held flat" in r.getMessage()]
 
 
+def test_table_law_queried_outside_its_velocities_during_a_run_warns_once(tmp_path, caplog):
+    # the law is evaluated at the state velocity Dc/theta, which a stick takes below the
+    # driving velocity: at V = 0.05 (inside [0.03, 100]) down to about 0.016, held flat there
+    path = tmp_path / "t.csv"
+    V = np.geomspace(0.03, 100.0, 9)
+    pd.DataFrame({"V": V, "sigma": rsf.HyperbolicLaw(mu_inf=0.9).mu_ss(V)}).to_csv(path, index=False)
+    table = ["--k0", "0.3", "--law", "table", "--table", str(path)]
+    with caplog.at_level(logging.WARNING, logger="rsf"):
+        assert main(["run", *table, "--V", "0.05", "--t-end", "30", "--out", str(tmp_path / "o.csv")]) == 0
+    flat = [r.getMessage() for r in caplog.records if "held flat" in r.getMessage()]
+    assert len(flat) == 1, flat
+    assert re.match(r"simulate: the state velocity Dc/theta = 0\.01\d+ outside the table's velocities "
+                    r"\[0\.03, 100\]", flat[0]), flat[0]
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="rsf"):
+        assert main(["sweep", *table, "--V", "0.05,0.06", "--out", str(tmp_path / "s.csv")]) == 0
+    flat = [r.getMessage() for r in caplog.records if "held flat" in r.getMessage()]
+    assert len(flat) == 1 and flat[0].startswith("limit_cycle(V=0.05): the state velocity Dc/theta = 0.01"), flat
+    # the API says it too; a run that stays inside the table says nothing
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="rsf"):
+        law = rsf.TabulatedLaw(V, rsf.HyperbolicLaw(mu_inf=0.9).mu_ss(V))
+        rsf.simulate(rsf.SpringSlider(law, k0=0.3), 0.05, t_end=30.0)
+        assert len([r for r in caplog.records if "held flat" in r.getMessage()]) == 1
+        law = rsf.TabulatedLaw(V, rsf.HyperbolicLaw(mu_inf=0.9).mu_ss(V))
+        rsf.simulate(rsf.SpringSlider(law, k0=0.3), 1.0, t_end=30.0)
+        assert len([r for r in caplog.records if "held flat" in r.getMessage()]) == 1
+
+
 def test_history_shorter_than_t_end_warns(tmp_path, caplog):
     hist = tmp_path / "h.csv"
     pd.DataFrame({"t": [0.0, 10.0], "V": [1.0, 2.0]}).to_csv(hist, index=False)
@@ -318,6 +346,70 @@ def test_two_state_run_writes_theta2(tmp_path):
     # one state variable: the columns are unchanged
     assert main(["run", "--k0", "0.01", *log, "--steps", "1:10,3", "--t-end", "60", "--out", str(out)]) == 0
     assert list(pd.read_csv(out).columns) == ["t", "x", "sigma", "theta", "v"]
+
+
+# --- row 12: a run's rows are bounded (a 60-unit Nagata run wrote 170-183k rows) ----------------
+NAGATA = ["--k0", "0.1", "--Dc", "0.006", "--V", "1", "--eta-rad", "1e-3", "--law", "log",
+          "--state-law", "nagata"]
+
+
+def test_a_long_run_writes_a_bounded_number_of_rows(tmp_path, monkeypatch, capsys):
+    # at rtol 1e-10 each fast cycle takes ~700 integrator steps; by default rsf run writes every
+    # step only while there are at most OUT_ROWS of them, else one row per t-end/OUT_ROWS
+    # between events (made small here so that a short run shows it)
+    import rsf.cli
+
+    monkeypatch.setattr(rsf.cli, "OUT_ROWS", 100)
+    out, events, every = tmp_path / "o.csv", tmp_path / "e.csv", tmp_path / "all.csv"
+    assert main(["run", *NAGATA, "--t-end", "0.5", "--out", str(every), "--out-dt", "0"]) == 0
+    assert main(["run", *NAGATA, "--t-end", "0.5", "--out", str(out), "--events", str(events)]) == 0
+    steps, rows, ev = pd.read_csv(every), pd.read_csv(out), pd.read_csv(events)
+    assert len(steps) > 1000                                      # the integrator's own steps
+    assert f"wrote {len(rows)} rows to {out} (of {len(steps)} integrator steps: one row per --out-dt = " \
+           f"0.005 between events" in capsys.readouterr().err
+    assert len(rows) <= 100 + 1 + 2 * len(ev)
+    # the rows kept are exact steps, every event's row among them (the spring force's extrema)
+    model = rsf.SpringSlider(rsf.LogLaw(), k0=0.1, Dc=0.006, state_law=rsf.NagataLaw(2.0), eta_rad=1e-3)
+    run = rsf.simulate(model, 1.0, t_end=0.5)
+    thin = run.thinned(0.005)
+    assert len(thin.t) == len(rows) and len(run.t) == len(steps)
+    kept = np.isin(run.t, thin.t)
+    assert np.array_equal(thin.sigma, run.sigma[kept]) and np.array_equal(thin.v, run.v[kept])
+    at_events = np.isin(run.t, [e.t for e in run.events])
+    assert at_events.sum() >= 5 and np.all(kept[at_events])
+    force, thin_force = run.sigma + 1e-3 * run.v, thin.sigma + 1e-3 * thin.v     # the spring's force
+    assert thin_force.max() == force.max() and thin_force.min() == force.min()
+    assert np.all((np.diff(thin.t) >= 0.005) | np.isin(thin.t[1:], [e.t for e in run.events]) |
+                  (thin.t[1:] == run.t[-1]))
+    # a run of at most OUT_ROWS steps keeps them all; --out-dt thins any run
+    assert main(["run", *NAGATA, "--t-end", "0.01", "--out", str(out)]) == 0
+    assert len(pd.read_csv(out)) <= 100
+    assert main(["run", *NAGATA, "--t-end", "0.5", "--out", str(out), "--out-dt", "0.1"]) == 0
+    assert len(pd.read_csv(out)) <= 6 + 2 * len(ev)
+    helptext = " ".join(build_parser()._subparsers._group_actions[0].choices["run"].format_help().split())
+    assert "at most about t-end/OUT_DT + 2 per event" in helptext
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--out-dt", "-1"], "error: --out-dt must be in [0, 0.5], got -1"),
+    (["--out-dt", "nan"], "error: --out-dt must be in [0, 0.5], got nan"),
+    (["--out-dt", "0.1", "--t-eval-n", "3"], "error: give at most one of --t-eval, --t-eval-n and --out-dt"),
+])
+def test_out_dt_is_checked(extra, message, tmp_path, capsys):
+    assert main(["run", *NAGATA, "--t-end", "0.5", "--out", str(tmp_path / "o.csv"), *extra]) == 2
+    assert _error_line(capsys) == message
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_thinned_keeps_events_and_both_rows_of_a_slip():
+    run = rsf.simulate(rsf.SpringSlider(k0=0.1), 0.05, t_end=30.0)         # a = 0: instantaneous slips
+    thin = run.thinned(5.0)
+    slips = [e.t for e in run.events if e.kind == "stick->slip"]
+    assert slips and all(np.count_nonzero(thin.t == t) == 2 for t in slips)
+    assert thin.t[0] == 0.0 and thin.t[-1] == run.t[-1] and thin.events == run.events
+    assert run.thinned(0.0) is run and len(thin.t) < len(run.t)
+    with pytest.raises(ValueError, match=r"^dt must be a finite number >= 0, got -1$"):
+        run.thinned(-1.0)
 
 
 # --- row 1: a long run over steady sliding finishes; one bound on t_end for API and CLI ------
