@@ -144,9 +144,10 @@ def _model_options(p: argparse.ArgumentParser, *, k0_list: bool = False) -> None
                    help="log progress to stderr")
     g = p.add_argument_group("model (defaults: the paper's Fig. 4)")
     if k0_list:
-        g.add_argument("--k0", required=True, help="driving-spring stiffness(es), > 0; comma-separated for several")
+        g.add_argument("--k0", required=True,
+                       help=f"driving-spring stiffness(es), in (0, {K0_MAX:g}]; comma-separated for several")
     else:
-        g.add_argument("--k0", type=float, required=True, help="driving-spring stiffness, > 0")
+        g.add_argument("--k0", type=float, required=True, help=f"driving-spring stiffness, in (0, {K0_MAX:g}]")
     g.add_argument("--k1", type=float, default=0.1, help="elastic coupling, >= 0 (default 0.1)")
     g.add_argument("--k2", type=float, default=0.9, help="viscoelastic coupling, >= 0 (default 0.9)")
     g.add_argument("--zbar", type=float, default=0.1, help="mean pinning distance, > 0 (default 0.1)")
@@ -206,7 +207,15 @@ def _fp_options(args) -> tuple[FP, Convergence]:
                                                                               open_low=True))
     if args.t_max is not None:
         conv = Convergence(rtol=conv.rtol, t_max=_bounded(args.t_max, "--t-max", 0.0, T_MAX, open_low=True))
-    return FP(eps=args.eps), conv
+    try:
+        return FP(eps=args.eps), conv
+    except ValueError as exc:  # (name the flag the user typed: "eps must be ..." -> "--eps must be ...")
+        raise ValueError(_flag("eps", str(exc)).replace(" (or None for the default)", "")) from None
+
+
+def _flag(name: str, message: str) -> str:
+    """``message`` starting with the parameter ``name`` as the flag's name instead."""
+    return f"--{name.replace('_', '-')}{message[len(name):]}" if message.startswith(name + " ") else message
 
 
 def _cohort_options(args) -> Cohort:
@@ -321,7 +330,10 @@ def _options(args, models: list[Model]):
     fp_opts, convergence = _fp_options(args)
     if fp_used:
         for model in models:
-            fp_opts.settings(model)
+            try:
+                fp_opts.settings(model)
+            except ValueError as exc:
+                raise ValueError(_flag("eps", str(exc))) from None
     cohort = _cohort_options(args) if cohort_used else None
     if cohort is not None:
         for model in models:

@@ -149,6 +149,11 @@ def test_cli_sweep_keeps_the_rows_before_a_failing_row(tmp_path, monkeypatch):
     (["run", "--k0", "0.1", "--V", "1", "--duration", "1", "--cohort-tol", "1e-5"], "--cohort-tol sets the cohort"),
     (["sweep", "--k0", "0.01", "--V", "4", "--cohort-h", "1"], "--cohort-h must be in"),
     (["sweep", "--k0", "0.01", "--V", "4", "--cohort-dt", "0.5"], "--cohort-dt must be a finite number in"),
+    # issue 39 row 11: the flag as typed, not the parameter (these said "eps must be ...")
+    (["sweep", "--k0", "0.1", "--V", "1", "--method", "fp", "--eps", "0"],
+     "error: --eps must be a finite number > 0, got 0.0"),
+    (["sweep", "--k0", "0.1", "--V", "1", "--method", "fp", "--eps", "0.1"],
+     "error: --eps must be in [kappa*zbar/1000, kappa*zbar/4] = [0.00011, 0.0275]"),
 ])
 def test_cli_refuses_a_flag_of_a_method_it_does_not_use(tmp_path, capsys, cohort_calls, argv, flag):
     from micro.cli import main
