@@ -48,6 +48,8 @@ import numpy as np
 import scipy.linalg
 
 from . import _cohort_kernels as CK
+from . import _cohort_newton
+from ._threads import blas_single_threaded
 from .params import KIND_EXPONENTIAL, Model
 from .results import CycleFixedPoint
 
@@ -108,6 +110,11 @@ BAND_COLOURS = 16
 BAND_ABOVE = 6
 #: The forward-difference step of the full map's response to a shift of the marginal.
 SHIFT_FD = 1e-4
+#: Where the frozen map grows (its slowest multiplier >= 1: Anderson's preconditioner bounds
+#: nothing), the fixed point is solved by Newton-Krylov on the whole cycle map
+#: (:func:`_newton`), each cycle quantity to this fraction of ``tol`` (its change over the
+#: last Newton step).
+NEWTON_TOL = 0.1
 #: A run whose five-cycle window contracts by more than this a cycle is accelerated (where
 #: the loading phase is shorter than SHORT_PHASE and shocks all but total); one that
 #: extrapolated (Aitken) such a sequence without the acceleration says in its message that
@@ -645,6 +652,36 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, base: _C
     return best, max_evals, slow, best_f
 
 
+def _newton(step: float, dt: float, base: _Cohorts, tol: float, max_evals: int) -> _cohort_newton.NewtonKrylov:
+    """The fixed point of the cycle map on the delta_R marginal after a shock
+    (:func:`_carried_cycle` from the state ``base`` just after one, at the step ``step``
+    and its graded-grid reference), by Newton-Krylov on the whole map
+    (:mod:`micro._cohort_newton`: GMRES with Jacobian-vector products by differences of
+    the map, no frozen-slip linearisation), each judged column to NEWTON_TOL * ``tol``,
+    in at most ``max_evals`` cycles.  The map does not apply (the evaluation is refused)
+    where a cycle fails, leaves more than ANDERSON_UNJUMPED of the blocks unjumped or
+    needs a shorter step.  At k0 = 0.01, 0.9 V^c, cell kappa zbar / 40, where the frozen
+    map grows (multiplier 1.03), a solve to 1e-9 from near the fixed point takes 50-80
+    cycles and ends at a residual of 1e-10 to 1e-8 of the mass (the map's round-off;
+    docs/validation/micro_cohort.md section 5)."""
+    ref = base.period_ref
+    if max_evals < 4 or not base.dense(base.n - 1).sum() > 0.0:
+        return _cohort_newton.NewtonKrylov(message="no budget left for Newton-Krylov")
+
+    def cycle_map(state: _Cohorts):
+        """The map from ``state`` (carrying the blocks its last shock left), and its marginal."""
+        def G(v: np.ndarray):
+            st, out, g = _carried_cycle(state, step, ref, v)
+            if g is None or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
+                return st, out, None
+            return st, out, g
+        dep = state.dense(state.n - 1)
+        return G, dep / dep.sum()
+    G, x0 = cycle_map(base)
+    return _cohort_newton.solve(G, x0, tol=NEWTON_TOL * tol, max_evals=max_evals,
+                                columns=tuple(COLUMNS[i] for i in JUDGED), log=log.debug, rebase=cycle_map)
+
+
 def _peak_before(st: _Cohorts, t_start: float, dt: float) -> float:
     """The largest stress on a graded mesh from the snapshot ``st`` to the shock's start
     at ``t_start`` (steps of half the time left): where the creep outruns the drive just
@@ -831,6 +868,7 @@ def not_applicable(model: Model) -> str:
     return ""
 
 
+@blas_single_threaded
 def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None = None, tol: float = 1e-5,
                   max_iter: int = 200, start=None) -> CycleFixedPoint:
     """The stick-slip limit cycle at drive velocity ``V``, by the cohort method (module
@@ -848,14 +886,21 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     marginal after a shock is solved by Anderson's method preconditioned by the cycle at
     frozen slips (:func:`_anderson`), the result verified by plain cycles again, and each
     error is then at least the last step times m / (1 - m), m the map's slowest
-    multiplier.  ``error`` is the error of the fixed point at this ``dt`` and ``h``, not
+    multiplier.  Where that frozen map grows (m >= 1, and the bound does not hold) the
+    fixed point is solved by Newton-Krylov on the whole cycle map instead (:func:`_newton`),
+    and each error is the largest of its last Newton step's change, the plain cycles'
+    estimate after it and their distance from its fixed point.  ``error`` is the error of
+    the fixed point at this ``dt`` and ``h``, not
     their discretisation error (``h`` defaults to ``kappa zbar / 20``).  Close to V^c
     without the acceleration (shocks that leave many blocks, k0 = 0.1, 0.3) five cycles
     can hide a slower mode, and the message then says so.  ``dt``
     is the step of loading phases longer than SHORT_PHASE, within ``1 / gamma`` of their
     ends (up to four times longer between: :func:`_step_length`); shorter ones (close to
     V^c) get steps ``dt * T / SHORT_PHASE`` (a fiftieth of T at the default dt).
-    ``eps`` in the result is ``h``.
+    ``eps`` in the result is ``h``.  BLAS runs on one thread inside (Anderson's least
+    squares and its preconditioner's factorisation: with two threads their last bits, and
+    so the path and the step of a run close to V^c, differed from one thread's; the map's
+    own sums do not depend on numba's thread count).
     """
     begin = time.perf_counter()
     why = not_applicable(model)
@@ -897,6 +942,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     out: dict = {}
     it, accelerated, passed = 0, False, 0
     slow_multiplier = math.nan
+    newton, newton_tries = None, 0  # Newton-Krylov's result, where the frozen map grows
     while it < max_iter:
         it += 1
         out = _one_cycle(st, step)
@@ -950,6 +996,17 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             fast, used, slow_multiplier, residual = _anderson(model, V, h, step, dt, st, st.period_ref,
                                                               ANDERSON_TOL * tol, max((int(max_iter) - it) // 2, 1))
             it += used
+            if slow_multiplier >= 1.0:
+                # the frozen map grows along some mode, so neither Anderson's iteration nor the
+                # bound m / (1 - m) holds: Newton-Krylov on the whole cycle map, whose error is
+                # its last step, with half the cycles left (from far off, as in a coarse run's
+                # first cycles, its steps are halved and the budget can run out: the plain
+                # cycles then go on from Anderson's state, with a second try below)
+                newton = _newton(step, dt, fast if fast is not None else st, tol, (int(max_iter) - it) // 2)
+                newton_tries += 1
+                it += newton.evals
+                if newton.certified:
+                    fast = newton.state
             if fast is not None:
                 st = fast
                 hist.clear()
@@ -958,6 +1015,32 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if len(hist) < WINDOW:
             continue
         passed = passed + 1 if error <= tol else 0
+        if passed >= 2 and accelerated and slow_multiplier >= 1.0 and newton is not None and newton.certified:
+            # the plain cycles from Newton's fixed point: the error is the larger of Newton's
+            # (its last step), the cycles' own estimate, and how far they moved from it
+            drift = np.abs(np.array(hist)[-WINDOW:, list(JUDGED)]
+                           - np.array([newton.row[COLUMNS[i]] for i in JUDGED])).max(axis=0)
+            error = float(max(np.max(errors[list(JUDGED)]), newton.error, drift.max()))
+            converged, value = True, best
+            message = (f"limit cycle by cohorts, by Newton-Krylov on the cycle map (the frozen map's slowest "
+                       f"multiplier is {slow_multiplier:.4f} >= 1, so Anderson's bound does not hold): residual "
+                       f"{newton.residual:.1e} of the mass in {newton.evals} cycles, its last step moved the "
+                       f"stresses by {newton.error:.1e}; cycles {it - WINDOW + 1}-{it} (of {it}) stay within "
+                       f"{drift.max():.1e} of it; error {error:.1e}")
+            break
+        if passed >= 2 and accelerated and slow_multiplier >= 1.0 and newton_tries < 2 \
+                and not (newton is not None and newton.certified):
+            # the plain cycles' test is not enough where the frozen map grows: a second try of
+            # Newton-Krylov from where they passed it (closer to the fixed point), then the
+            # plain cycles again (leaving them at least 2 WINDOW of the budget)
+            newton = _newton(step, dt, st, tol, max(int(max_iter) - it - 2 * WINDOW, 0))
+            newton_tries += 1
+            it += newton.evals
+            if newton.certified:
+                st = newton.state
+                hist.clear()
+                passed = 0
+                continue
         if passed >= 2 and accelerated and slow_multiplier >= 1.0:
             # the frozen map grows along some mode: it gives no bound on what a slower mode of
             # the full map leaves, and the plain cycles' test alone is not enough (at k0 = 0.01,
@@ -968,7 +1051,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             message = (f"limit cycle by cohorts, its error not known: the cycles pass the stopping test after "
                        f"Anderson's iteration (its last step {residual:.1e} of the mass), but the frozen map's "
                        f"slowest multiplier is {slow_multiplier:.4f} >= 1, so nothing bounds a slower mode of "
-                       f"the cycle map (no certified fixed point; measured 3e-5 off where checked)")
+                       f"the cycle map (no certified fixed point; measured 3e-5 off where checked), and "
+                       f"Newton-Krylov on the whole map did not certify one "
+                       f"({newton.message if newton is not None else 'not run'})")
             break
         if passed >= 2:  # (two cycles in a row: one estimate may pass by chance)
             converged, value = True, best
