@@ -915,7 +915,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     if int(max_iter) != max_iter or max_iter < 4:
         raise ValueError(f"max_iter must be an integer >= 4, got {max_iter!r}")
     given = start if start is not None and start is not _NO_COARSE else None
-    coarse = None
+    coarse, from_coarse = None, False
     st = _continued(given, model, V, h)
     step = dt
     if st is None and start is not _NO_COARSE and (given is None or given.p is None) \
@@ -929,6 +929,8 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             st = _continued(coarse, model, V, h)
             if st is not None:
                 step = _phase_step(coarse.period, dt)  # (the coarse cycle's loading phase, SHORT_PHASE / dt steps)
+                # (a coarse fixed point certified to this run's tol: Newton-Krylov's start, below)
+                from_coarse = coarse.converged and coarse.error <= tol
             elif coarse.p is not None:
                 given = coarse
     if st is None:
@@ -1001,8 +1003,13 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 # bound m / (1 - m) holds: Newton-Krylov on the whole cycle map, whose error is
                 # its last step, with half the cycles left (from far off, as in a coarse run's
                 # first cycles, its steps are halved and the budget can run out: the plain
-                # cycles then go on from Anderson's state, with a second try below)
-                newton = _newton(step, dt, fast if fast is not None else st, tol, (int(max_iter) - it) // 2)
+                # cycles then go on from Anderson's state, with a second try below).  Where this
+                # run continues a coarse fixed point certified to tol and Anderson did not meet
+                # its tolerance, it starts from the state Anderson started from: at k0 = 1e-3,
+                # V = 70 it certified from there in 44 cycles, and from Anderson's stalled state
+                # not in 190 (docs/validation/micro_cohort.md section 5)
+                origin = st if from_coarse and not residual <= ANDERSON_TOL * tol else fast
+                newton = _newton(step, dt, origin if origin is not None else st, tol, (int(max_iter) - it) // 2)
                 newton_tries += 1
                 it += newton.evals
                 if newton.certified:
