@@ -1058,7 +1058,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             message = (f"limit cycle by cohorts, its error not known: the cycles pass the stopping test after "
                        f"Anderson's iteration (its last step {residual:.1e} of the mass), but the frozen map's "
                        f"slowest multiplier is {slow_multiplier:.4f} >= 1, so nothing bounds a slower mode of "
-                       f"the cycle map (no certified fixed point; measured 3e-5 off where checked), and "
+                       f"the cycle map (no certified fixed point; such runs were 3e-5 to 4e-4 off where checked), and "
                        f"Newton-Krylov on the whole map did not certify one "
                        f"({newton.message if newton is not None else 'not run'})")
             break
