@@ -308,7 +308,7 @@ class ViscoelasticLaw(SteadyStateLaw):
     Parameters
     ----------
     f_th : float
-        Pinning threshold (paper: 1).
+        Pinning threshold, > 0 (paper: 1).
     zbar : float
         Mean well spacing, > 0 (paper: 0.1).
     k1 : float
@@ -336,7 +336,7 @@ class ViscoelasticLaw(SteadyStateLaw):
     name: str = field(default="viscoelastic", init=False, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "f_th", finite("f_th", self.f_th))
+        object.__setattr__(self, "f_th", positive("f_th", self.f_th))
         object.__setattr__(self, "zbar", positive("zbar", self.zbar))
         object.__setattr__(self, "k1", nonnegative("k1", self.k1))
         object.__setattr__(self, "k2", positive("k2", self.k2))
