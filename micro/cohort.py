@@ -587,6 +587,23 @@ def _band_preconditioner(model: Model, V: float, h: float, G, x: np.ndarray, out
     return M, slowest
 
 
+def _applied_cycle(base: _Cohorts, step: float, ref: float, dt: float, v: np.ndarray):
+    """:func:`_carried_cycle` from ``base`` with the marginal ``v``, its image ``g`` None
+    where the cycle map does not apply: the cycle failed, left more than ANDERSON_UNJUMPED
+    of the blocks unjumped, or needs a shorter step than ``step`` (the accelerations'
+    common rule)."""
+    st, out, g = _carried_cycle(base, step, ref, v)
+    if g is None or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
+        return st, out, None
+    return st, out, g
+
+
+def _marginal(state: _Cohorts) -> np.ndarray:
+    """The delta_R marginal of the blocks ``state``'s last shock made, normalised."""
+    dep = state.dense(state.n - 1)
+    return dep / dep.sum()
+
+
 def _anderson(model: Model, V: float, h: float, step: float, dt: float, base: _Cohorts, ref: float,
               tol: float, max_evals: int) -> tuple[_Cohorts | None, int, float]:
     """Anderson's acceleration of the cycle map on the delta_R marginal after a shock
@@ -606,13 +623,12 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, base: _C
     """
     xs: list[np.ndarray] = []
     gs: list[np.ndarray] = []
-    dep = base.dense(base.n - 1)
-    x, best, best_f = dep / dep.sum(), None, math.inf
+    x, best, best_f = _marginal(base), None, math.inf
     since, M, slow = 0, None, math.nan
     backtracks = 0
     for k in range(1, max_evals + 1):
-        st, out, g = _carried_cycle(base, step, ref, x)
-        if g is None or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
+        st, out, g = _applied_cycle(base, step, ref, dt, x)
+        if g is None:
             if not xs or backtracks >= ANDERSON_BACKTRACKS:
                 return best, k, slow, best_f
             # far from the fixed point (a sweep's first cycles) a step can overshoot into
@@ -670,13 +686,7 @@ def _newton(step: float, dt: float, base: _Cohorts, tol: float, max_evals: int) 
 
     def cycle_map(state: _Cohorts):
         """The map from ``state`` (carrying the blocks its last shock left), and its marginal."""
-        def G(v: np.ndarray):
-            st, out, g = _carried_cycle(state, step, ref, v)
-            if g is None or out["unjumped"] > ANDERSON_UNJUMPED or _step_too_long(out["period"], step, dt):
-                return st, out, None
-            return st, out, g
-        dep = state.dense(state.n - 1)
-        return G, dep / dep.sum()
+        return (lambda v: _applied_cycle(state, step, ref, dt, v)), _marginal(state)
     G, x0 = cycle_map(base)
     return _cohort_newton.solve(G, x0, tol=NEWTON_TOL * tol, max_evals=max_evals,
                                 columns=tuple(COLUMNS[i] for i in JUDGED), log=log.debug, rebase=cycle_map)

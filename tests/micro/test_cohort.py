@@ -502,11 +502,10 @@ def test_a_sweep_reaches_the_fixed_point_close_to_vc():
     assert res.sigma_max == pytest.approx(0.9138256, abs=1e-6)
 
 
-def test_a_frozen_map_that_grows_leaves_the_fixed_point_uncertified(monkeypatch):
-    # k0 = 0.01, 0.9 V^c is accelerated; where the frozen-slip map (Anderson's
-    # preconditioner) has a multiplier >= 1 nothing bounds a slower mode, and a pass of the
-    # plain cycles' test was measured 3e-5 short of the fixed point (cell kappa zbar / 40,
-    # docs/validation/micro_cohort.md section 5): the run must not claim to be converged.
+def _run_with_a_growing_frozen_map(monkeypatch):
+    """k0 = 0.01, 0.9 V^c at dt = 0.04, cell kappa zbar / 10, from a cold start, with
+    Anderson's frozen-slip map reported as growing (slowest multiplier 1.03); asserts that
+    the run was accelerated, so that the caller exercises that path."""
     from micro import cohort
     real = cohort._anderson
     seen = []
@@ -517,13 +516,23 @@ def test_a_frozen_map_that_grows_leaves_the_fixed_point_uncertified(monkeypatch)
         return best, used, 1.03, step
 
     monkeypatch.setattr(cohort, "_anderson", growing)
-    # (such a run is then solved by Newton-Krylov on the whole map, which certifies it:
-    # here it finds no fixed point, as where its budget runs out)
-    monkeypatch.setattr(cohort, "_newton", lambda *a, **k: cohort._cohort_newton.NewtonKrylov(message="none"))
     model = micro.Model(k0=0.01)
     V = 0.9 * micro.critical_velocity(model).Vc
     res = cycle_cohorts(model, V, dt=0.04, h=model.kappa * model.zbar / 10.0, start=_NO_COARSE)
     assert seen, "the run was not accelerated: the test no longer exercises the acceleration"
+    return res
+
+
+def test_a_frozen_map_that_grows_leaves_the_fixed_point_uncertified(monkeypatch):
+    # k0 = 0.01, 0.9 V^c is accelerated; where the frozen-slip map (Anderson's
+    # preconditioner) has a multiplier >= 1 nothing bounds a slower mode, and a pass of the
+    # plain cycles' test was measured 3e-5 short of the fixed point (cell kappa zbar / 40,
+    # docs/validation/micro_cohort.md section 5): the run must not claim to be converged.
+    from micro import cohort
+    # (such a run is then solved by Newton-Krylov on the whole map, which certifies it:
+    # here it finds no fixed point, as where its budget runs out)
+    monkeypatch.setattr(cohort, "_newton", lambda *a, **k: cohort._cohort_newton.NewtonKrylov(message="none"))
+    res = _run_with_a_growing_frozen_map(monkeypatch)
     # the stopping test is met (so the row stands), but the error is not known
     assert res.converged and math.isnan(res.error)
     assert "no certified fixed point" in res.message and "1.0300 >= 1" in res.message
@@ -538,20 +547,7 @@ def test_a_frozen_map_that_grows_is_solved_by_newton_krylov(monkeypatch):
     and drift, by 1.4e-7 in 700 cycles here; docs/validation/micro_cohort.md section 5).
     Before, such a run reported error NaN.  (At the real grow, kappa zbar / 40 at dt =
     0.02: the slow test below.)"""
-    from micro import cohort
-    real = cohort._anderson
-    seen = []
-
-    def growing(*args, **kwargs):
-        best, used, slow, step = real(*args, **kwargs)
-        seen.append(slow)
-        return best, used, 1.03, step
-
-    monkeypatch.setattr(cohort, "_anderson", growing)
-    model = micro.Model(k0=0.01)
-    V = 0.9 * micro.critical_velocity(model).Vc
-    res = cycle_cohorts(model, V, dt=0.04, h=model.kappa * model.zbar / 10.0, start=_NO_COARSE)
-    assert seen, "the run was not accelerated: the test no longer exercises the acceleration"
+    res = _run_with_a_growing_frozen_map(monkeypatch)
     assert res.converged and math.isfinite(res.error) and res.error < 1e-6, res.message
     assert "Newton-Krylov" in res.message and "1.0300 >= 1" in res.message
     # the reference's own step (the run's path sets it: the same path here)
