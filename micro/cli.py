@@ -184,8 +184,8 @@ def _refuse(args, flags, why: str) -> None:
             raise ValueError(f"--{name.replace('_', '-')} {why}")
 
 
-#: The model's parameter names and the flags that set them (for the messages).
-_FLAGS = {"k0": "--k0", "k1": "--k1", "k2": "--k2", "zbar": "--zbar", "eta_u": "--eta-u", "f_th": "--f-th"}
+#: The model's parameters set by flags of the same name (``eta_u``: ``--eta-u``; for the messages).
+_MODEL_FLAGS = ("k0", "k1", "k2", "zbar", "eta_u", "f_th")
 
 
 def _model(args, k0: float) -> Model:
@@ -197,8 +197,8 @@ def _model(args, k0: float) -> Model:
         if text.startswith("cutoff"):  # (the CLI's exponential jumps are cut at 10)
             raise ValueError(f"--zbar must be below the exponential jumps' cutoff 10, got {args.zbar:g}") from None
         name = re.match(r"[A-Za-z_][A-Za-z0-9_]*", text)
-        if name and name.group(0) in _FLAGS:
-            raise ValueError(_FLAGS[name.group(0)] + text[name.end():]) from None
+        if name and name.group(0) in _MODEL_FLAGS:
+            raise ValueError(_flag(name.group(0), text)) from None
         raise
 
 
