@@ -224,9 +224,8 @@ class Stationary:
         renewal chain's own error estimate on steady rows; on cohort rows the largest
         change of sigma_max and sigma_min from the run at twice the time step and cell
         (its transient) plus both runs' fixed-point errors, away from V^c
-        (``micro.api.NEAR_VC``); NaN where it is not known (close to V^c the cohort's
-        cell refinement is not monotone, and on Fokker-Planck rows it takes a study in
-        eps).
+        (``micro.api.NEAR_VC``, d = 0.02); NaN where it is not known (closer to V^c, and on
+        Fokker-Planck rows, where it takes a study in eps).
     records : pandas.DataFrame or None
         The stress time series (columns ``t, sigma, sigma_min, sigma_max,
         sigma_mean``) of a Fokker-Planck run asked for ``keep_records``; else None.
