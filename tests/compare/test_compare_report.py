@@ -136,14 +136,15 @@ def test_transition_table_one_row_per_method_with_interval_and_range(rep):
 def test_transition_verdict_is_one_paragraph_on_both_sides(rep):
     """The verdict a physicist can quote: both lose stability the same singular way, RS's
     d^(1/2) with the prefactor from the map, micro's fitted exponent with range and interval,
-    and that micro's law below d = 0.2 is not settled."""
+    and how far micro's error bars are checked."""
     text = rep.values["transition_verdict"]
     assert "\n" not in text and text in rep.summary
     law = rep.values["rs_amplitude_law"]
     cohort = rep["hopf_fit"].set_index("method").loc["cohort"]
     for part in ("same singular way", "c0 d^(1/2) (1 + c2 d)", f"c0 = {law['c0']:.4g}",
                  f"beta = {cohort.beta:.2f} (95 % CI {cohort.beta_low:.2f} to {cohort.beta_high:.2f})",
-                 "it has no single power law", "crossover at d of about k0/k2", "not yet settled below d = 0.2"):
+                 "it has no single power law", "crossover at d of about k0/k2", "checked against the Richardson limit",
+                 "down to d = 0.02"):
         assert part in text, part
 
 
