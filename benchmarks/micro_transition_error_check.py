@@ -15,9 +15,14 @@ sigma_min and the amplitude.  A level whose fixed point is not certified (error 
 is kept, and no limit is drawn through it.
 
 Writes benchmarks/results/micro_transition_error_check.csv (one row per point and level;
-rows merge by k0, d, dt).
+rows merge by k0, d, dt) and the figure micro_transition_error_check.png: the amplitude
+against d on log-log axes, each k0's default rows with their bars (twice the bound: both
+extrema) and the Richardson limits, the N-block at each N of
+``micro_transition_nblock_check.csv`` where it exists (k0 = 0.1); and each error over the
+amplitude.  ``--plot`` redraws the figure from the CSVs alone.
 
-    python benchmarks/micro_transition_error_check.py --k0 0.3,0.1,0.01,0.001 --d 0.2,0.1,0.05,0.02,0.01
+    python benchmarks/micro_transition_error_check.py --k0 0.01 --d 0.2,0.1,0.05,0.02,0.01   # about 1 h of CPU
+    python benchmarks/micro_transition_error_check.py --plot
 """
 from __future__ import annotations
 
@@ -30,9 +35,10 @@ import pandas as pd
 import micro
 from micro.cohort import cycle_cohorts
 
-from _harness import RESULTS, Stopwatch, warm_up, write_csv
+from _harness import RESULTS, Stopwatch, pyplot, save_figure, warm_up, write_csv
 
 CSV = RESULTS / "micro_transition_error_check.csv"
+NBLOCK_CSV = RESULTS / "micro_transition_nblock_check.csv"
 
 
 def _row(k0, d, V, vc, level, dt, h, res, cpu):
@@ -73,6 +79,44 @@ def check(frame: pd.DataFrame) -> dict:
             "true_amplitude": abs(d0.amplitude - la), "true_over_bound": max(tx, ty) / out["bound"]}
 
 
+def plot() -> None:
+    """The figure, from the CSVs."""
+    f = pd.read_csv(CSV)
+    nb = pd.read_csv(NBLOCK_CSV) if NBLOCK_CSV.exists() else pd.DataFrame()
+    plt = pyplot()
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.4))
+    for i, (k0, g) in enumerate(f.groupby("k0")):
+        c = f"C{i}"
+        row = g[g.level == 0].sort_values("d")
+        ok = row.certified.astype(bool)
+        ax.errorbar(row.d[ok], row.amplitude[ok], yerr=2 * row.bound[ok], fmt="o", color=c, ms=4, capsize=2,
+                    label=f"k0 = {k0:g}: default row (dt = {row.dt.iloc[0]:g}), bar = 2 x its bound")
+        ax.plot(row.d[~ok], row.amplitude[~ok], "o", mfc="none", color=c, ms=5)
+        lim = row[np.isfinite(row.limit_amplitude)]
+        ax.plot(lim.d, lim.limit_amplitude, "x", color=c, ms=7)
+        ax2.plot(lim.d, lim.bound / lim.amplitude, "o-", color=c, label=f"k0 = {k0:g}: bound / A")
+        ax2.plot(lim.d, np.maximum(lim.true_sigma_max, lim.true_sigma_min) / lim.amplitude, "x--", color=c,
+                 label=f"k0 = {k0:g}: true error / A")
+    for j, (N, g) in enumerate(nb.groupby("N") if len(nb) else []):
+        g = g.sort_values("d")
+        ax.errorbar(g.d, g.amplitude, yerr=g.amplitude_stderr, fmt="s", mfc="none", ms=3 + j, color="0.4",
+                    alpha=0.5 + 0.5 * j / max(1, nb.N.nunique() - 1), label=f"N-block k0 = 0.1, N = {N:.0e}")
+    ax.plot([], [], "x", color="k", label="Richardson limit of two finer levels")
+    ax.plot([], [], "o", mfc="none", color="k", label="fixed point not certified")
+    for a in (ax, ax2):
+        a.set_xscale("log")
+        a.set_yscale("log")
+        a.set_xlabel("d = (V^c - V) / V^c")
+    ax.set_ylabel("amplitude sigma_max - sigma_min")
+    ax2.set_ylabel("error / amplitude")
+    ax.legend(fontsize=6.5, loc="lower right")
+    ax2.legend(fontsize=6.5)
+    ax.set_title("the cohort method near V^c, checked (default rows, finer levels, N-block)", fontsize=9)
+    ax2.set_title("the default row's bound against its true error", fontsize=9)
+    fig.tight_layout()
+    save_figure(fig, RESULTS / "micro_transition_error_check.png")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--k0", default="0.3,0.1,0.01,0.001")
@@ -80,7 +124,11 @@ def main() -> None:
     ap.add_argument("--dt", type=float, default=0.02, help="the default row's step (the report's cycle_dt)")
     ap.add_argument("--tol", type=float, default=1e-4, help="the fixed points' tolerance (the report's)")
     ap.add_argument("--levels", type=int, default=2, help="finer levels (dt and h halved at each)")
+    ap.add_argument("--plot", action="store_true", help="only redraw the figure from the CSVs")
     args = ap.parse_args()
+    if args.plot:
+        plot()
+        return
     warm_up(micro.stationary, micro.Model(k0=0.05), 0.77, method=micro.Cohort(dt=0.04))
     for k0 in [float(v) for v in args.k0.split(",")]:
         model = micro.Model(k0=k0)
@@ -113,6 +161,7 @@ def main() -> None:
             print(f"k0 = {k0:g}, d = {d:g}: amplitude {row.sigma_max - row.sigma_min:.6f}, bound {chk['bound']:.1e}, "
                   f"true {max(chk['true_sigma_max'], chk['true_sigma_min']):.1e}, order {chk['order']:.2f}", flush=True)
             write_csv(f, CSV, keys=["k0", "d", "dt_default", "level"])
+    plot()
 
 
 if __name__ == "__main__":

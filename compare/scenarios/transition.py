@@ -278,8 +278,8 @@ def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
     each_N = ", ".join(f"{r.beta:.2f} at N = {r.resolution:.0f}" for _, r in nb.iterrows())
     moves = f"; the N-block's exponent moves with N ({each_N})" if len(nb) > 1 else ""
     out.append(f"The cohort method's error bars are bounds (the change from twice its time step and cell, plus "
-               "both fixed points' errors), checked against the Richardson limit of two finer levels at k0 = 0.1, "
-               f"0.01 and 1e-3 down to d = {NEAR_VC:g}, where they cover the true error several times over "
+               "both fixed points' errors), checked against the Richardson limit of two finer levels at k0 = 0.3, "
+               f"0.1, 0.01 and 1e-3 down to d = {NEAR_VC:g}, where they cover the true error several times over "
                "(docs/validation/micro_transition.md); closer to V^c they are not known, and at k0 = 0.01, d = 0.01 "
                f"the report's step no longer certifies the fixed point{moves}.")
     return " ".join(out)
