@@ -122,13 +122,12 @@ def _cohort_row(model: Model, V: float, opts: Cohort, warn: bool,
     if not res.applicable:
         return None
     d = 1.0 - V / _vc(model)
-    certified = math.isfinite(res.error) and (res.coarse is None or math.isfinite(res.coarse.error))
-    if res.coarse is not None and d >= NEAR_VC and certified:
+    if d >= NEAR_VC and math.isfinite(res.discretisation_bound):
         # the change of the cycle from twice the step and cell, plus what the two fixed points
         # may still be off (a bound on the coarse cycle's discretisation error, so on this one's)
-        change = max(abs(res.sigma_max - res.coarse.sigma_max), abs(res.sigma_min - res.coarse.sigma_min))
-        disc = change + res.coarse.error + res.error
-        covers = (f"; discretisation error at most {disc:.1e} (the change {change:.1e} from dt = {2 * opts.dt:g}, "
+        disc = res.discretisation_bound
+        covers = (f"; discretisation error at most {disc:.1e} (the change {res.coarse_change:.1e} from "
+                  f"dt = {2 * opts.dt:g}, "
                   f"h = {2 * h:.3g}, plus both fixed points' errors); fixed-point error {res.error:.1e}")
     else:
         disc = math.nan
