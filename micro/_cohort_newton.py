@@ -109,8 +109,7 @@ def solve(G: Callable, x0: np.ndarray, *, tol: float, max_evals: int,
         if res.evals >= max_evals:
             raise _MapFailed(f"the budget of {max_evals} cycles is used up")
         res.evals += 1
-        st, row, g = G(v)
-        return st, row, g
+        return G(v)
 
     x = _normalised(np.asarray(x0, float))
     try:
