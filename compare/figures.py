@@ -347,10 +347,10 @@ def fig3(t: dict[str, pd.DataFrame], path: Path) -> Path:
     d = t["fig3_traces"]
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
     for V, g in d.groupby("V"):
-        ax.plot(g.t * V, g.sigma, lw=0.8, label=f"V = {V:g}")
+        ax.plot(g.t * V, g.sigma, lw=0.8, label=f"V = {V:g} ({g['method'].iloc[0] if 'method' in g else 'fp'})")
     ax.set_xlabel("drive displacement w = V t")
     ax.set_ylabel("sigma")
-    ax.set_title(f"Fig. 3: micro, k0 = {d.k0.iloc[0]:g}", fontsize=9)
+    ax.set_title(f"Fig. 3: micro, k0 = {d.k0.iloc[0]:g}, from a start", fontsize=9)
     ax.legend(fontsize=7)
     return _save(fig, path)
 

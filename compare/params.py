@@ -110,8 +110,9 @@ class Settings:
         that a = b - W(V) > 0).
     shs_k0, shs_V, hold_times : slide-hold-slide (Fig. 7): stiffness, drive velocity (must
         be steady) and hold times.
-    paper_figures : also the paper's Fig. 3 (sigma(t) at k0 = 0.01) and Fig. 10 (the FP's
-        sigma against eps at ``fig10_k0``, ``fig10_eps``, against the exact value).
+    paper_figures : also the paper's Fig. 3 (sigma(t) at k0 = 0.01 from a start, by the
+        N-block with ``fig3_N`` blocks) and Fig. 10 (the FP's sigma against eps at
+        ``fig10_k0``, ``fig10_eps``, against the exact value).
         ``fig10_t_max``: each Fig. 10 run stops at this simulated time, settled or not (an
         unsettled one is drawn open, with its mean over the last cycles): where the
         discretised density oscillates it never settles, and at the default t_max three of
@@ -162,6 +163,7 @@ class Settings:
     hold_times: tuple[float, ...] = (0.1, 0.3, 1.0, 2.0, 4.0, 8.0, 16.0)
     classical_b: float = 0.01
     paper_figures: bool = False
+    fig3_N: int = 100_000
     fig10_k0: tuple[float, ...] = (0.3, 0.1)
     fig10_eps: tuple[float, ...] = (0.025, 0.02, 0.016, 0.0125)
     fig10_t_max: float = 120.0
@@ -240,6 +242,7 @@ class Settings:
         set_("fig10_eps", tuple(sorted(positive_array("fig10_eps", self.fig10_eps, low=0.0, high=1.0, min_size=0),
                                        reverse=True)))
         set_("fig10_t_max", positive("fig10_t_max", self.fig10_t_max))
+        set_("fig3_N", positive_int("fig3_N", self.fig3_N, low=100, high=10**7))
         set_("scenarios", choices("scenarios", self.scenarios, SCENARIOS))
         # every time-stepped micro model must accept the bins
         for k0 in self.fp_k0 + (self.hopf_k0, self.shs_k0):

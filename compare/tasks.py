@@ -488,14 +488,17 @@ class NBlockTask(_TaskBase):
 
 @dataclass(frozen=True)
 class TraceTask(_TaskBase):
-    """``micro.simulate(model, drive)``: the stress against time under a piecewise-constant
-    drive (``segments`` of (duration, velocity)), recorded at least every
-    ``duration / n_samples``.
+    """The stress against time under a piecewise-constant drive (``segments`` of
+    (duration, velocity)), from a start, recorded at least every ``duration / n_samples``:
+    by ``micro.simulate(model, drive)`` (``method="fp"``, the Fokker-Planck equation), or by
+    ``micro.nblock.simulate_nblock`` with ``n_blocks`` blocks (``method="nblock"``).
 
-    Its result is ``{"t": [...], "sigma": [...]}``, the run's records: besides the
-    ``n_samples`` intervals, :func:`micro.simulate` records whenever the stress has moved
-    by a quarter of k0 eps (the grid's jitter), so a trace through stick-slip holds many
-    more samples.
+    Its result is ``{"t": [...], "sigma": [...], "method": ...}``.  The FP's records:
+    besides the ``n_samples`` intervals, :func:`micro.simulate` records whenever the stress
+    has moved by a quarter of k0 eps (the grid's jitter), so a trace through stick-slip
+    holds many more samples.  The N-block's: the stress at the end of each of the
+    ``n_samples`` intervals, and each global shock's stress before and after it (so a
+    sawtooth keeps its peaks).
 
     Parameters
     ----------
@@ -505,37 +508,58 @@ class TraceTask(_TaskBase):
         The drive's ``(duration, velocity)`` segments, as :class:`micro.Drive` takes them;
         kept as a tuple of float pairs.
     numerics : micro.Numerics
-        The Fokker-Planck options.
+        The Fokker-Planck options (not used by the N-block, nor part of its description).
     n_samples : int
         The duration over the longest interval between records (default 4000).
+    method : str
+        ``"fp"`` (default) or ``"nblock"``.
+    n_blocks : int
+        The N-block's number of blocks, >= 10 (default 100 000).
+    seed : int
+        The N-block's seed of the pinning distances, >= 0 (default 0).
 
     Raises
     ------
     ValueError
-        If a segment is refused by :class:`micro.Drive`, ``numerics`` is not a
-        :class:`micro.Numerics` or its bin is out of range for the model, or the jumps
-        are :class:`micro.Tabulated`.
+        If a segment is refused by :class:`micro.Drive`, ``method`` is neither, ``numerics``
+        is not a :class:`micro.Numerics` or its bin is out of range for the model, a count
+        is not an integer at least its bound, or the jumps are :class:`micro.Tabulated`.
     """
 
     model: micro.Model
     segments: tuple[tuple[float, float], ...]
     numerics: micro.Numerics
     n_samples: int = 4000
+    method: str = "fp"
+    n_blocks: int = 100_000
+    seed: int = 0
     kind = "trace"
 
     def __post_init__(self) -> None:
         segs = tuple((float(d), float(v)) for d, v in self.segments)
         micro.Drive(segs)  # validates durations and velocities
         object.__setattr__(self, "segments", segs)
+        if self.method not in ("fp", "nblock"):
+            raise ValueError(f"method must be 'fp' or 'nblock', got {self.method!r}")
         if not isinstance(self.numerics, micro.Numerics):
             raise ValueError(f"numerics must be a micro.Numerics, got {type(self.numerics).__name__}")
-        self.numerics.settings(self.model)
+        for name, low in (("n_samples", 1), ("n_blocks", 10), ("seed", 0)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        if self.method == "fp":
+            self.numerics.settings(self.model)
         model_description(self.model)
 
     def describe(self) -> dict[str, Any]:
-        return {"kind": self.kind, "model": model_description(self.model),
-                "segments": [list(s) for s in self.segments], "n_samples": int(self.n_samples),
-                "numerics": _numerics_description(self.numerics, self.model)}
+        d = {"kind": self.kind, "model": model_description(self.model),
+             "segments": [list(s) for s in self.segments], "n_samples": int(self.n_samples)}
+        if self.method == "fp":
+            d["numerics"] = _numerics_description(self.numerics, self.model)
+        else:
+            d.update(method=self.method, n_blocks=self.n_blocks, seed=self.seed)
+        return d
 
     def label(self) -> str:
         m = self.model
@@ -543,10 +567,23 @@ class TraceTask(_TaskBase):
 
     def run(self) -> dict[str, Any]:
         duration = sum(d for d, _ in self.segments)
+        if self.method == "nblock":
+            from micro.nblock import simulate_nblock
+            r = simulate_nblock(self.model, list(self.segments), self.n_blocks, seed=self.seed,
+                                record_every=duration / self.n_samples)
+            ts, sh = r.timeseries, r.shocks
+            t = np.concatenate((ts.t, sh.t, sh.t))
+            sigma = np.concatenate((ts.sigma, sh.sigma_before, sh.sigma_after))
+            # (at a shock's time: the stress before it, then after it)
+            rank = np.concatenate((np.ones(len(ts)), np.zeros(len(sh)), np.full(len(sh), 2.0)))
+            order = np.lexsort((rank, t))
+            return {"t": t[order].tolist(), "sigma": sigma[order].tolist(), "method": "nblock",
+                    "n_blocks": self.n_blocks}
         run = micro.simulate(self.model, micro.Drive(self.segments), numerics=self.numerics,
                              record_dt=duration / self.n_samples)
         rec = run.records
-        return {"t": np.asarray(rec.t, float).tolist(), "sigma": np.asarray(rec.sigma, float).tolist()}
+        return {"t": np.asarray(rec.t, float).tolist(), "sigma": np.asarray(rec.sigma, float).tolist(),
+                "method": "fp"}
 
 
 Task = SteadyTask | VcTask | NBlockTask | TraceTask | StationaryTask | CriticalTask | SlideHoldSlideTask

@@ -6,6 +6,7 @@ import importlib
 from collections import Counter
 from types import SimpleNamespace
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -66,3 +67,38 @@ def test_the_paper_figure_10_runs_stop_at_their_time_budget():
     for bad in (0.0, -1.0, float("nan")):
         with pytest.raises(ValueError, match="^fig10_t_max must be"):
             compare.Settings.paper(fig10_t_max=bad)
+
+
+def test_the_paper_figure_3_traces_are_by_the_method_that_carries_each_transient_cheaply():
+    """Fig. 3's slow trace (V = 0.001: N-block, cost with the jumps) and its fast ones (FP,
+    cost with the simulated time); ``fig3_N`` reaches the N-block task and is validated."""
+    paper = importlib.import_module("compare.scenarios.paper")
+    settings = compare.Settings.paper(fig3_N=20000)
+    ctx = SimpleNamespace(s=settings, model=settings.model)
+    tasks = paper._fig3_tasks(ctx)
+    assert [(t.segments[0][1], t.method) for t in tasks] == [(0.001, "nblock"), (5.0, "fp"), (9.8, "fp")]
+    assert tasks[0].n_blocks == 20000 and tasks[0].describe()["n_blocks"] == 20000
+    assert "numerics" not in tasks[0].describe() and "n_blocks" not in tasks[1].describe()
+    for bad in (0, 50, 2.5, True):
+        with pytest.raises(ValueError, match="^fig3_N must be"):
+            compare.Settings.paper(fig3_N=bad)
+
+
+def test_an_nblock_trace_keeps_each_shocks_peak_and_drop():
+    """An N-block trace through total shocks (k0 = 0.01, V = 0.01, N = 5000, two loading
+    phases): the stress falls at each shock from its peak to within finite-N noise of the
+    exact stress after a total shock, f_th - kappa zbar (micro.sigma_fast_limit, by hand
+    from the model), and time runs forward."""
+    model = compare.Settings().model(0.01)
+    task = compare.TraceTask(model, ((1500.0, 0.01),), compare.Settings().numerics(), n_samples=300,
+                             method="nblock", n_blocks=5000)
+    r = task.run()
+    t, sigma = np.array(r["t"]), np.array(r["sigma"])
+    assert r["method"] == "nblock" and np.all(np.diff(t) >= 0.0)
+    drops = np.flatnonzero(np.diff(sigma) < -0.03)
+    assert len(drops) >= 2
+    after = model.f_th - model.kappa * model.zbar
+    assert np.all(np.abs(sigma[drops + 1] - after) < 3e-3)
+    assert np.all(sigma[drops] > after + 0.05) and sigma.max() == sigma[drops].max()
+    with pytest.raises(ValueError, match="^method must be"):
+        compare.TraceTask(model, ((1.0, 1.0),), compare.Settings().numerics(), method="cohort")
