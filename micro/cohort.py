@@ -804,6 +804,16 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
                 sigma_after=st.sigma, unjumped=unjumped, start=sigma_start, steps=steps)
 
 
+def _trace(out: dict, k0: float, V: float) -> tuple[np.ndarray, np.ndarray]:
+    """A cycle's stress at its steps' ends, from the stress after the shock before it
+    (``out`` from :func:`_one_cycle`; a step of length ``l`` and slip ``x`` moves the
+    stress by ``k0 (V l - x)``, the shock is the last step, of length 0)."""
+    length, slip = np.array(out["steps"], float).reshape(-1, 2).T
+    t = np.concatenate(([0.0], np.cumsum(length)))
+    sigma = out["start"] + np.concatenate(([0.0], np.cumsum(k0 * (V * length - slip))))
+    return t, sigma
+
+
 #: The columns of a cycle's row in the history, and those whose error decides convergence.
 COLUMNS = ("sigma_max", "sigma_min", "period", "sigma_mean", "sigma_before", "sigma_after")
 JUDGED = (0, 1, 4, 5)
@@ -1101,6 +1111,8 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         coarse=coarse if coarse is not None and coarse.applicable and coarse.converged else None)
     if res.coarse is not None:
         res.coarse.state = None  # (the fine run continued it; keep only its numbers)
+    if out.get("ok"):
+        res.trace = _trace(out, model.k0, V)
     if applicable and len(hist):
         st.dt = step
         res.state = st

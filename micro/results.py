@@ -93,6 +93,12 @@ class CycleFixedPoint:
     coarse : CycleFixedPoint or None
         The same cycle at twice the step and cell when the run started from it (its
         transient), if that run converged; else None.
+    trace : tuple of ndarray, or None
+        The last cycle's stress against time, ``(t, sigma)``: t = 0 right after the shock
+        before it, then the end of each of its steps, and last the shock's drop (two
+        points at t = ``period``).  The stress between step ends is not sampled, so the
+        largest point can lie a little below ``sigma_max`` (the peak the creep before the
+        shock makes).  None where no cycle ended.
     """
 
     model: Model
@@ -118,6 +124,7 @@ class CycleFixedPoint:
     sigma_after: float = math.nan
     accelerated: bool = False
     coarse: "CycleFixedPoint | None" = field(default=None, repr=False)
+    trace: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
 
     @property
     def coarse_change(self) -> float:

@@ -85,6 +85,23 @@ def test_a_long_loading_phase_takes_longer_steps_in_its_middle(monkeypatch):
         assert graded[name] == pytest.approx(uniform[name], abs=2e-6)
 
 
+def test_the_cycles_trace_is_its_steps_stresses():
+    """``trace``: the last cycle's stress at each step's end, from the stress its steps and
+    slips give (k0 (V l - x) a step).  It must start and end at sigma_after (a fixed point),
+    hold sigma_before and the time mean sigma_mean, and stay within the cycle's extrema."""
+    model = micro.Model(k0=0.1)
+    V = 0.3 * micro.critical_velocity(model).Vc
+    res = cycle_cohorts(model, V, dt=0.02, tol=1e-6)
+    t, sigma = res.trace
+    err = 5 * res.error
+    assert t[0] == 0.0 and t[-1] == pytest.approx(res.period, rel=1e-5)  # (error covers the stresses)
+    assert sigma[0] == pytest.approx(res.sigma_after, abs=err) and sigma[-1] == pytest.approx(res.sigma_after, abs=err)
+    assert sigma[-2] == pytest.approx(res.sigma_before, abs=err)
+    assert sigma.min() == pytest.approx(res.sigma_min, abs=err) and sigma.max() <= res.sigma_max + err
+    mean = np.sum(0.5 * (sigma[1:] + sigma[:-1]) * np.diff(t)) / t[-1]
+    assert mean == pytest.approx(res.sigma_mean, abs=err)
+
+
 @pytest.mark.parametrize("k0, frac", [(0.01, 0.5), (1e-4, 0.95)])
 def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
     """A step's Newton iteration starts from the slip rate of the steps before (the fold's
