@@ -167,7 +167,7 @@ def _direct_then_cycle(model: Model, V: float, opts: Auto, numerics: FP | None, 
         return direct
     why = cohort_not_applicable(model)
     if why:
-        return _fp_row(model, V, numerics, convergence, warn, why=why.split(" (")[0])
+        return _fp_row(model, V, numerics, convergence, warn, why=why)
     row = _cohort_row(model, V, opts.cohort, warn, start)
     if row is not None:
         return row

@@ -281,7 +281,8 @@ def test_cohort_falls_back_without_exponential_jumps():
     res = micro.stationary(model, 0.1, method="cohort", numerics=micro.Numerics(eps=0.025),
                            convergence=micro.Convergence(rtol=5e-2, t_max=40.0), warn=False)
     assert res.method == "fp"
-    assert res.message.startswith("the cohort method needs exponential jumps: Fokker-Planck time-stepping")
+    assert res.message.startswith("the cohort method needs exponential jumps (a jumped block's margin is then "
+                                  "Exp(kappa zbar)): Fokker-Planck time-stepping")
 
 
 def test_cohort_rejects_bad_input():

@@ -164,7 +164,8 @@ def test_without_exponential_jumps_the_cohort_method_says_so_and_the_fokker_plan
     for method in ("auto", "cohort", micro.Cohort(dt=0.02)):
         res = micro.stationary(model, V, method=method)
         assert res.method == "fp"
-        assert res.message == "the cohort method needs exponential jumps: Fokker-Planck time-stepping; (spy)"
+        assert res.message == ("the cohort method needs exponential jumps (a jumped block's margin is then "
+                               "Exp(kappa zbar)): Fokker-Planck time-stepping; (spy)")
     assert calls == [(model, V)] * 3
 
 
@@ -187,6 +188,7 @@ def test_an_exponential_truncated_by_its_cutoff_is_not_given_to_the_cohort_metho
     monkeypatch.setattr(micro.api, "cycle_cohorts", cohort_spy)
     res = micro.stationary(model, V)
     assert res.method == "fp" and res.message.startswith("the cohort method needs exponential jumps whose cutoff")
+    assert "(cutoff >= 30 zbar = 3, got 0.3)" in res.message  # (the row says the numbers, as the error does)
 
     taken = micro.Model(k0=0.05, jumps=micro.Exponential(0.1, cutoff=3.0))
     monkeypatch.setattr(micro.api, "cycle_cohorts", lambda *a, **k: (_ for _ in ()).throw(RuntimeError("cohort")))
