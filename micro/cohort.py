@@ -1042,33 +1042,33 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         if len(hist) < WINDOW:
             continue
         passed = passed + 1 if error <= tol else 0
-        if passed >= 2 and accelerated and slow_multiplier >= 1.0 and newton is not None and newton.certified:
-            # the plain cycles from Newton's fixed point: the error is the larger of Newton's
-            # (its last step), the cycles' own estimate, and how far they moved from it
-            drift = np.abs(np.array(hist)[-WINDOW:, list(JUDGED)]
-                           - np.array([newton.row[COLUMNS[i]] for i in JUDGED])).max(axis=0)
-            error = float(max(np.max(errors[list(JUDGED)]), newton.error, drift.max()))
-            converged, value = True, best
-            message = (f"limit cycle by cohorts, by Newton-Krylov on the cycle map (the frozen map's slowest "
-                       f"multiplier is {slow_multiplier:.4f} >= 1, so Anderson's bound does not hold): residual "
-                       f"{newton.residual:.1e} of the mass in {newton.evals} cycles, its last step moved the "
-                       f"stresses by {newton.error:.1e}; cycles {it - WINDOW + 1}-{it} (of {it}) stay within "
-                       f"{drift.max():.1e} of it; error {error:.1e}")
-            break
-        if passed >= 2 and accelerated and slow_multiplier >= 1.0 and newton_tries < 2 \
-                and not (newton is not None and newton.certified):
-            # the plain cycles' test is not enough where the frozen map grows: a second try of
-            # Newton-Krylov from where they passed it (closer to the fixed point), then the
-            # plain cycles again (leaving them at least 2 WINDOW of the budget)
-            newton = _newton(step, dt, st, tol, max(int(max_iter) - it - 2 * WINDOW, 0))
-            newton_tries += 1
-            it += newton.evals
-            if newton.certified:
-                st = newton.state
-                hist.clear()
-                passed = 0
-                continue
         if passed >= 2 and accelerated and slow_multiplier >= 1.0:
+            # the frozen map grows along some mode (Anderson's bound does not hold)
+            if newton is not None and newton.certified:
+                # the plain cycles from Newton's fixed point: the error is the larger of Newton's
+                # (its last step), the cycles' own estimate, and how far they moved from it
+                drift = np.abs(np.array(hist)[-WINDOW:, list(JUDGED)]
+                               - np.array([newton.row[COLUMNS[i]] for i in JUDGED])).max(axis=0)
+                error = float(max(np.max(errors[list(JUDGED)]), newton.error, drift.max()))
+                converged, value = True, best
+                message = (f"limit cycle by cohorts, by Newton-Krylov on the cycle map (the frozen map's slowest "
+                           f"multiplier is {slow_multiplier:.4f} >= 1, so Anderson's bound does not hold): residual "
+                           f"{newton.residual:.1e} of the mass in {newton.evals} cycles, its last step moved the "
+                           f"stresses by {newton.error:.1e}; cycles {it - WINDOW + 1}-{it} (of {it}) stay within "
+                           f"{drift.max():.1e} of it; error {error:.1e}")
+                break
+            if newton_tries < 2:
+                # the plain cycles' test is not enough where the frozen map grows: a second try of
+                # Newton-Krylov from where they passed it (closer to the fixed point), then the
+                # plain cycles again (leaving them at least 2 WINDOW of the budget)
+                newton = _newton(step, dt, st, tol, max(int(max_iter) - it - 2 * WINDOW, 0))
+                newton_tries += 1
+                it += newton.evals
+                if newton.certified:
+                    st = newton.state
+                    hist.clear()
+                    passed = 0
+                    continue
             # the frozen map grows along some mode: it gives no bound on what a slower mode of
             # the full map leaves, and the plain cycles' test alone is not enough (at k0 = 0.01,
             # 0.9 V^c, h = kappa zbar / 40 it passed 3e-5 short of the fixed point that 450
