@@ -30,6 +30,8 @@ grows a little faster than N, about 3.6 times per factor 3):
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --d 0.01,0.02,0.05 --N 3000000   # 33 min
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --d 0.01 --N 100000,300000,1000000 --shock-fraction 0.3
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --d 0.01 --N 100000,300000,1000000 --shock-fraction 0.05
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1,0.05,0.02 --N 100000,300000
+        # k0 = 0.01: 2-3 times the cost at k0 = 0.1 (each block jumps 7-13 times in a total shock)
 """
 from __future__ import annotations
 
