@@ -5,8 +5,9 @@ Fig. 3: sigma(t) at k0 = 0.01 for V = 0.001, 5 and 9.8 from a start: transients 
 V = 0.001 the cycles' peaks still fall from cycle to cycle), which the cohort method does
 not carry.  Each trace by the cheaper of the two methods that carry them: the N-block
 with ``fig3_N`` blocks at the slow drive (its cost goes with the jumps, about N a cycle:
-13.5 s for N = 1e5 against the Fokker-Planck equation's 85 s at the report's bin, and
-closer to its own large-N limit), the Fokker-Planck equation at V = 5 and 9.8 (its cost
+13.5 s for N = 1e5 against the Fokker-Planck equation's 85 s at the report's bin; the FP
+refined to eps = 0.004 meets it, at the report's bin it is 2.5e-3 low in the first peak),
+the Fokker-Planck equation at V = 5 and 9.8 (its cost
 goes with the simulated time: a few seconds, where the N-block takes two minutes);
 docs/validation/micro_defaults.md.
 Fig. 10: the FP's stress at V = 1.5 V^c against its bin eps (``fig10_k0``,
