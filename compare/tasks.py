@@ -111,6 +111,16 @@ def _check_common(model, numerics, convergence) -> None:
     numerics.settings(model)  # eps within the solver's range, or a ValueError naming eps
 
 
+def _check_counts(task: Any, bounds: tuple[tuple[str, int], ...]) -> None:
+    """Each field ``name`` of the frozen ``task`` an integer >= ``low`` (a bool and a float are
+    refused), stored as an int; else a ValueError naming it."""
+    for name, low in bounds:
+        value = getattr(task, name)
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+            raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+        object.__setattr__(task, name, int(value))
+
+
 class _TaskBase:
     kind: str = "task"
 
@@ -465,11 +475,7 @@ class NBlockTask(_TaskBase):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "V", positive("V", self.V))
-        for name, low in (("n_blocks", 10), ("n_cycles", 2), ("n_discard", 0), ("seed", 0)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-            object.__setattr__(self, name, int(value))
+        _check_counts(self, (("n_blocks", 10), ("n_cycles", 2), ("n_discard", 0), ("seed", 0)))
         model_description(self.model)
 
     def describe(self) -> dict[str, Any]:
@@ -543,11 +549,7 @@ class TraceTask(_TaskBase):
             raise ValueError(f"method must be 'fp' or 'nblock', got {self.method!r}")
         if not isinstance(self.numerics, micro.Numerics):
             raise ValueError(f"numerics must be a micro.Numerics, got {type(self.numerics).__name__}")
-        for name, low in (("n_samples", 1), ("n_blocks", 10), ("seed", 0)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-            object.__setattr__(self, name, int(value))
+        _check_counts(self, (("n_samples", 1), ("n_blocks", 10), ("seed", 0)))
         if self.method == "fp":
             self.numerics.settings(self.model)
         model_description(self.model)
