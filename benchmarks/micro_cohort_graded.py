@@ -31,10 +31,6 @@ from _harness import K0, RESULTS, timed, warm_up, write_csv
 QUANTITIES = ("sigma_max", "sigma_min", "sigma_before", "sigma_after")
 
 
-def _cap(text: str) -> float:
-    return float(text)  # "inf" included
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--k0", default=",".join(str(k) for k in K0))
@@ -47,7 +43,7 @@ def main() -> None:
     ap.add_argument("--out", default=str(RESULTS / "micro_cohort_graded.csv"))
     args = ap.parse_args()
     out = Path(args.out)
-    caps = [_cap(v) for v in args.graded_max.split(",")]
+    caps = [float(v) for v in args.graded_max.split(",")]  # ("inf" included)
     warm_up(cohort.cycle_cohorts, micro.Model(k0=0.1), 0.3, tol=1e-3, max_iter=6)
     graded_max = cohort.GRADED_MAX
     for k0 in (float(v) for v in args.k0.split(",")):
