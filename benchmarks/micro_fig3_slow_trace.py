@@ -26,11 +26,6 @@ CSV = RESULTS / "micro_fig3_slow_trace.csv"
 K0, V = 0.01, 0.001
 
 
-def _first_slow_shock(t: np.ndarray, sigma: np.ndarray, t_shock: float) -> tuple[float, float]:
-    after = t > 100.0
-    return float(t_shock), float(sigma[after & (t <= t_shock)].max())
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--eps", default="0.016,0.008", help="FP bins (comma-separated; empty for none)")
@@ -45,9 +40,9 @@ def main() -> None:
         run, wall = timed(micro.simulate, model, micro.Drive(((args.t_end, V),)), numerics=micro.Numerics(eps=eps),
                           record_dt=args.t_end / 4000)
         t, sigma = np.asarray(run.records.t), np.asarray(run.records.sigma)
-        falls = np.flatnonzero((np.diff(sigma) < -0.01) & (t[:-1] > 100.0))
-        shock = t[falls[0]] if len(falls) else np.nan
-        t1, peak = _first_slow_shock(t, sigma, shock) if len(falls) else (np.nan, np.nan)
+        falls = np.flatnonzero((np.diff(sigma) < -0.01) & (t[:-1] > 100.0))  # (the first: the shock's start)
+        t1 = float(t[falls[0]]) if len(falls) else np.nan
+        peak = float(sigma[(t > 100.0) & (t <= t1)].max()) if len(falls) else np.nan
         rows.append(dict(method="fp", resolution=eps, t_shock=t1, peak=peak, wall_s=wall))
     if args.N:
         warm_up(simulate_nblock, model, V, 1000, t_max=10.0)
