@@ -584,16 +584,16 @@ def test_close_to_vc_the_fine_cell_is_certified_by_newton_krylov():
     (multiplier 1.028), Anderson's iteration stalls, and the run used to report error NaN
     (its plain cycles passed the stopping test 2e-6 to 3e-5 from where others stopped).
     Newton-Krylov certifies the fixed point, and plain cycles from it stay within its
-    error.  At the step this path takes, benchmarks/micro_cohort_newton_krylov.py solved
-    the same map to its round-off: sigma_max 0.9141058716 (5.1e-8; the run: 0.9141058570,
-    error 1.2e-6).  (About 60 s.)"""
+    error.  At the step this path takes, benchmarks/micro_cohort_newton_krylov.py
+    (``--points 40:0.02 --no-consistent``) solved the same map to its round-off: sigma_max
+    0.9141064382 (1.5e-9; the run: 0.9141064395, error 1.7e-7).  (About 20 s.)"""
     model = micro.Model(k0=0.01)
     V = 0.9 * micro.critical_velocity(model).Vc
     res = cycle_cohorts(model, V, dt=0.02, h=model.kappa * model.zbar / 40.0, tol=2e-5)
     assert res.converged and res.accelerated and math.isfinite(res.error) and res.error < 2e-6, res.message
     assert "Newton-Krylov" in res.message
-    assert res.state.dt == pytest.approx(0.008375236, rel=1e-6)
-    assert abs(res.sigma_max - 0.9141058716) <= res.error + 5.2e-8
+    assert res.state.dt == pytest.approx(0.0083801882, rel=1e-6)
+    assert abs(res.sigma_max - 0.9141064382) <= res.error + 1.5e-9
     st = res.state.copy()
     for _ in range(10):
         row = _one_cycle(st, res.state.dt)
