@@ -828,17 +828,20 @@ JUDGED = (0, 1, 4, 5)
 WINDOW = 5
 
 
-def _estimate(a: np.ndarray, tol: float) -> tuple[np.ndarray, list[str], np.ndarray, np.ndarray]:
+def _estimate(a: np.ndarray, tol: float, slowest: float = 0.0) -> tuple[np.ndarray, list[str], np.ndarray, np.ndarray]:
     """Each quantity's (column of ``a``, one row per cycle, at least WINDOW rows) error,
     how it was estimated, its best value and its contraction ratio (the smallest of the
     three), from the last WINDOW
     cycles: four differences, three ratios ``r`` of successive differences, and the
-    three Aitken extrapolations ``a_k + d_k r_k / (1 - r_k)`` they give.
+    three Aitken extrapolations ``a_k + d_k r_k / (1 - r_k)`` they give.  ``slowest``:
+    the multiplier of the map's slowest mode as far as it is known beforehand
+    (:func:`_relaxation_multiplier`); a step ``d`` along it leaves ``d m / (1 - m)``.
 
     - the last two steps are below ``tol / 100``: converged (to the map's noise), the
-      last cycle, with STILL times those steps as the error;
+      last cycle, with ``F`` = max(STILL, slowest / (1 - slowest)) times those steps as
+      the error;
     - a ratio is negative (the cycles alternate) and the last three steps are below
-      ``tol / STILL``: noise, not a drift; the last cycle, STILL times the steps;
+      ``tol / STILL``: noise, not a drift; the last cycle, ``F`` times the steps;
     - all three ratios in [0, 1): a geometric tail; the last extrapolation, with twice
       the spread of the three, plus the tail that the ratio's last rise, repeated once,
       would add, as the error (a slow mode taking over from a faster one raises the
@@ -851,6 +854,7 @@ def _estimate(a: np.ndarray, tol: float) -> tuple[np.ndarray, list[str], np.ndar
     """
     w = a[-WINDOW:]
     d = np.diff(w, axis=0)
+    still = max(STILL, slowest / (1.0 - slowest)) if slowest < 1.0 else math.inf
     errors, how, best, rho = np.empty(a.shape[1]), [], w[-1].copy(), np.zeros(a.shape[1])
     for i in range(a.shape[1]):
         di = d[:, i]
@@ -859,10 +863,10 @@ def _estimate(a: np.ndarray, tol: float) -> tuple[np.ndarray, list[str], np.ndar
         steps = np.abs(di)
         rho[i] = float(r.min())
         if steps[-2:].max() <= tol / 100.0:
-            errors[i] = STILL * steps[-2:].max()
+            errors[i] = still * steps[-2:].max()
             how.append("last steps")
         elif (r < 0.0).any() and steps[-3:].max() <= tol / STILL:
-            errors[i] = STILL * steps[-3:].max()
+            errors[i] = still * steps[-3:].max()
             how.append("noise")
         elif ((r >= 0.0) & (r < 1.0)).all():
             E = w[-3:, i] + di[-3:] * r / (1.0 - r)
@@ -875,6 +879,19 @@ def _estimate(a: np.ndarray, tol: float) -> tuple[np.ndarray, list[str], np.ndar
             errors[i] = steps[-3:].max() / max(1.0 - r.max(), 1e-3)
             how.append("slow")
     return errors, how, best, rho
+
+
+def _relaxation_multiplier(model: Model, period: float) -> float:
+    """The cycle map's slowest multiplier as the model gives it beforehand: between shocks a
+    block's delta_R relaxes alone, by ``1 - alpha (1 - exp(-gamma T))`` over a cycle of
+    period ``T`` (alpha = (k0 + k1) / kappa), and the marginal's moments relax like its
+    powers (:func:`_band_preconditioner`).  At k0 = 1e-3 it is 0.90 far from V^c and 0.9992
+    at d = 0.005 (T = 0.0088), where plain cycles moved by 8e-8 a cycle and drifted 3.1e-5
+    over the next 300 (docs/validation/micro_cohort.md section 5)."""
+    if not period > 0.0:
+        return 0.0
+    alpha = (model.k0 + model.k1) / model.kappa
+    return 1.0 - alpha * (1.0 - math.exp(-model.gamma * period))
 
 
 #: The cohort method takes an Exponential whose cutoff removes at most this fraction of the
@@ -1000,7 +1017,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
         log.info("cohort k0=%g V=%g h=%.3g cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f",
                  model.k0, V, h, it, out["sigma_max"], out["sigma_min"], out["sigma_before"])
         if len(hist) >= WINDOW:
-            errors, how, best, rho = _estimate(np.array(hist), tol)
+            errors, how, best, rho = _estimate(np.array(hist), tol, _relaxation_multiplier(model, out["period"]))
             if accelerated and 0.0 < slow_multiplier < 1.0:
                 # after the acceleration the sequence holds what the map's slowest modes
                 # left: a last step d leaves up to d m / (1 - m) to go (m the slowest
@@ -1008,7 +1025,10 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 last = np.abs(np.diff(np.array(hist)[-2:], axis=0)[0])
                 errors = np.maximum(errors, last * slow_multiplier / (1.0 - slow_multiplier))
             error = float(errors[list(JUDGED)].max())
-            slow = any(how[i] in ("Aitken", "slow") and rho[i] > SLOW_CAVEAT for i in JUDGED)
+            # (steps too small to show a ratio, but not small enough for the slowest mode's
+            # tail: a slow sequence as well)
+            slow = any((how[i] in ("Aitken", "slow") and rho[i] > SLOW_CAVEAT)
+                       or (how[i] in ("last steps", "noise") and errors[i] > tol) for i in JUDGED)
         elif eager and not accelerated:
             slow = True  # (the start's own run was accelerated: so is this one, at once)
         else:

@@ -350,6 +350,25 @@ def test_each_quantity_is_judged_on_its_own():
     assert rho[2] == pytest.approx(0.8, rel=1e-9)
 
 
+def test_tiny_steps_along_a_slow_mode_are_not_convergence():
+    """At k0 = 1e-3, d = 0.005 the cycles moved by 8e-8 a cycle (below tol / 100) and the
+    rule called them converged to 4e-7; 300 more cycles drifted by 3.1e-5
+    (docs/validation/micro_cohort.md section 5).  With the model's slowest multiplier there
+    (a lone block's relaxation over the period, 0.9992) the same steps leave m / (1 - m)
+    times themselves: not within tol; a fast map keeps the old factor five."""
+    from micro.cohort import _estimate, _relaxation_multiplier, STILL
+    model = micro.Model(k0=0.001)
+    m = _relaxation_multiplier(model, 0.0088)
+    assert m == pytest.approx(0.9992, abs=1e-4)
+    assert _relaxation_multiplier(model, 5.0) == pytest.approx(0.9, abs=2e-3)
+    n = np.arange(8)
+    a = np.tile((0.9006 - 1e-4 * m ** n)[:, None], (1, 4))  # (steps of 8e-8, 1e-4 to go)
+    errors, how, _, _ = _estimate(a, 2e-5, m)
+    assert how[0] == "last steps" and errors[0] > 2e-5 and errors[0] >= 0.9006 - a[-1, 0]
+    errors, how, _, _ = _estimate(a, 2e-5)
+    assert how[0] == "last steps" and errors[0] == pytest.approx(STILL * 1e-4 * (1 - m) * m ** 5, rel=1e-6)
+
+
 def test_anderson_beats_the_plain_cycles_close_to_vc():
     # k0 = 0.01, 0.9 V^c: the cycle map contracts by about 0.96 per cycle; fifteen cycles'
     # worth of Anderson's acceleration leaves a smaller residual than fifteen plain cycles
