@@ -114,8 +114,8 @@ SHIFT_FD = 1e-4
 #: nothing), the fixed point is solved by Newton-Krylov on the whole cycle map
 #: (:func:`_newton`), each cycle quantity to this fraction of ``tol`` (its change over the
 #: last Newton step, which bounds the error of the iterate after it: at k0 = 1e-3,
-#: 0.85 V^c the step that moved sigma_max by 2.8e-5 left it 2.4e-7 from the fixed point;
-#: at 0.1, a third step of 27 cycles was taken for nothing the report needs).
+#: 0.85 V^c the step that moved sigma_max by 2.8e-5 left it 2.4e-7 from the fixed point,
+#: which a third step, 27 cycles, then showed at the former 0.1).
 NEWTON_TOL = 0.5
 #: A run whose five-cycle window contracts by more than this a cycle is accelerated (where
 #: the loading phase is shorter than SHORT_PHASE and shocks all but total); one that
