@@ -527,6 +527,28 @@ def test_anderson_halves_a_step_the_map_does_not_apply_to(monkeypatch):
     assert np.abs(tried[3] - 0.5 * (tried[0] / tried[0].sum() + tried[2])).sum() < 1e-12
 
 
+def test_anderson_stops_at_once_where_the_frozen_map_grows(monkeypatch):
+    """Where the preconditioner's frozen map has a multiplier >= 1 the preconditioned
+    iteration does not contract (at k0 = 1e-3, 0.85 V^c its 35 evaluations wandered and
+    were thrown away): Anderson returns after its first evaluation with that multiplier,
+    and the caller solves by Newton-Krylov (docs/validation/micro_cohort.md section 5)."""
+    from micro import cohort
+    model, V, h, x, out, g, step, ref = _near_vc_product_cycle()
+    st = _start(model, V, h, None, dep=x)
+    st.period_ref = ref
+    real = cohort._band_preconditioner
+
+    def growing(*args, **kwargs):
+        M, slowest = real(*args, **kwargs)
+        return M, np.concatenate([[1.05], slowest[1:]])
+    monkeypatch.setattr(cohort, "_band_preconditioner", growing)
+    best, used, slow, residual = cohort._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 20)
+    assert used == 1 and slow == 1.05 and best is not None and 0.0 < residual < 1.0
+    monkeypatch.setattr(cohort, "_band_preconditioner", real)
+    _, used, slow, _ = cohort._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 3)
+    assert used == 3 and slow < 1.0
+
+
 @pytest.mark.slow
 def test_a_sweep_reaches_the_fixed_point_close_to_vc():
     """The Fig. 10 sweep at k0 = 1e-3: 0.5, 0.7, then 0.9 V^c, each row from the one
