@@ -617,8 +617,9 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, base: _C
     the last shock left unjumped (at most ANDERSON_UNJUMPED of the mass) carried from the
     evaluation before.  Type-II Anderson mixing of the preconditioned map
     x + M (G(x) - x) with a window of ANDERSON_WINDOW, stopped when its step (about the
-    distance to the fixed point) is below ``tol`` of the mass, or when ANDERSON_STALL
-    evaluations did not improve on the best one.  Returns the state after the best
+    distance to the fixed point) is below ``tol`` of the mass, when ANDERSON_STALL
+    evaluations did not improve on the best one, or after the first evaluation if the
+    frozen map's slowest multiplier is >= 1.  Returns the state after the best
     evaluation's cycle (a state of the full dynamics), or None if the map does not apply,
     the evaluations used, the frozen map's slowest multiplier (NaN if the preconditioner
     was not built) and the best evaluation's step (inf if none).
@@ -644,11 +645,6 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, base: _C
                                               x, out, g)
             slow = float(slowest[0])
             log.debug("anderson: frozen map's slowest multipliers %s", slowest)
-            if slow >= 1.0:
-                # the frozen map grows along some mode: the preconditioned iteration does not
-                # contract there (at k0 = 1e-3, 0.85 V^c its 35 evaluations wandered between
-                # 1e-3 and 4e-1 of the mass) and the caller solves by Newton-Krylov instead
-                return st, k, slow, float(np.abs(g - x).sum())
         step_x = M(g - x)  # about the distance to the fixed point
         f = float(np.abs(step_x).sum())
         log.debug("anderson %d: sigma_max %.10f, the cycle moves %.2e of the mass, the step %.2e", k,
@@ -658,7 +654,10 @@ def _anderson(model: Model, V: float, h: float, step: float, dt: float, base: _C
             best, best_f, since = st, f, 0
         else:
             since += 1
-        if best_f <= tol or since >= ANDERSON_STALL:
+        # (where the frozen map grows along some mode the preconditioned iteration does not
+        # contract: at k0 = 1e-3, 0.85 V^c its 35 evaluations wandered between 1e-3 and 4e-1
+        # of the mass; the caller solves by Newton-Krylov instead)
+        if best_f <= tol or since >= ANDERSON_STALL or slow >= 1.0:
             return best, k, slow, best_f
         xs.append(x)
         gs.append(x + step_x)
