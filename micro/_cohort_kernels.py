@@ -78,8 +78,8 @@ def coefficients(t, dt, X, sigma, V, k0, k1, k2, f_th, gamma, t0, X0, s0, J, Ej,
 @njit(cache=True)
 def _i1(A, B, c, e):
     """int_0^1 (A + B s) exp(-c - e s) ds: by its series for |e| < 0.5 (the closed form
-    loses digits there: (1 - e^-e (1 + e)) / e^2 about 1e-16 / e^2 of them), else in
-    closed form."""
+    loses digits there: (1 - e^-e (1 + e)) / e^2 about 1e-16 / e^2 of them), summed until
+    a term falls below 1e-17 (the sums are 1/2 to 1), else in closed form."""
     if abs(e) < 0.5:
         # sum_n (-e)^n / n! * (A / (n + 1) + B / (n + 2)); the 19th term is below 1e-21
         term = 1.0
@@ -89,6 +89,8 @@ def _i1(A, B, c, e):
             a_sum += term / (n + 1)
             b_sum += term / (n + 2)
             term *= -e / (n + 1)
+            if abs(term) < 1e-17:
+                break
         return math.exp(-c) * (A * a_sum + B * b_sum)
     ee = math.exp(-e)
     return math.exp(-c) * (A * (1 - ee) / e + B * (1 - ee * (1 + e)) / (e * e))
@@ -107,6 +109,8 @@ def _i2(A, B, C, c, e):
             b_sum += term / (n + 2)
             c_sum += term / (n + 3)
             term *= -e / (n + 1)
+            if abs(term) < 1e-17:
+                break
         return math.exp(-c) * (A * a_sum + B * b_sum + C * c_sum)
     ee = math.exp(-e)
     e2 = e * e
@@ -256,61 +260,109 @@ def _closure(dX, n, co, j0, nn, off, q, m, ylo, h, lam, zbar):
     return zbar * N - dX, zbar * dN - 1.0
 
 
+# the round-off of H relative to the slip, from H evaluated about converged roots (a few
+# 1e-16 to 1.5e-15 of the slip): a root is known no better than ROUND * x / |H'|
+ROUND = 2e-15
+
+
+@njit(cache=True)
+def _quadratic_step(H, dH, c):
+    """The step to the first zero of H + dH u + c u^2 (Newton's step when c = 0, and when
+    the parabola has no zero)."""
+    disc = dH * dH - 4.0 * c * H
+    if disc < 0.0:
+        return -H / dH
+    return 2.0 * H / (-dH + math.sqrt(disc))
+
+
+@njit(cache=True)
+def _converged(step, x, tol, dH):
+    """A Newton step this small is below what the root is known to: ``1e-13 x + tol``, or
+    the round-off of H over its slope (which dominates close to a fold, where H' -> 0)."""
+    return step <= 1e-13 * (x + step) + tol + ROUND * x / abs(dH)
+
+
 @njit(cache=True)
 def _smallest_root(n, co, j0, nn, off, q, m, ylo, h, lam, zbar, tol, xmin, xguess):
     """The smallest root of H (status 0), or status 1 if H has a positive local minimum
-    before it: the slip jumps, a fold (the start of a shock).  Newton from 0 with steps
-    capped at doubling (from ``xmin``) so that a minimum is not jumped over, then
-    safeguarded Newton in the bracket, to ``1e-13 x + tol`` (``tol``: the round-off of H,
-    a sum over every cell, in units of slip).  Status 2: no convergence.
+    before it: the slip jumps, a fold (the start of a shock).  Status 2: no convergence.
 
-    ``xguess`` > 0 (a point short of the root, from the step before): where H is
-    positive and falling there, Newton starts there instead of from 0 (it would have
-    passed there: the capped steps from 0 jump over as much, so a minimum before it is
-    missed no more than by them); otherwise from 0."""
+    From the left (H > 0), with steps capped at doubling (from ``xmin``) so that a minimum
+    is not jumped over: each step goes to the first zero of the parabola through H, H' and
+    the curvature from the last two slopes (Newton's step at first).  Near a fold the root
+    is close to a double one, where Newton from the left only halves the distance a step;
+    the parabola takes it in one.  Once a point past the root is known (H <= 0), the same
+    step from the left end, with the curvature from both ends, safeguarded by bisection.
+    Converged when a Newton step is below ``1e-13 x + tol`` (``tol``: the round-off of H
+    in units of slip away from folds) or below the round-off of H over its slope
+    (:func:`_converged`).
+
+    ``xguess`` > 0 (a point close to the root, from the step before): where H is positive
+    and falling there, the iteration starts there instead of from 0 (it would have passed
+    there: the capped steps from 0 jump over as much, so a minimum before it is missed no
+    more than by them); where H is below zero there, it bounds the root from above and the
+    iteration starts from 0 in that bracket; where H is zero to round-off, it is the root."""
     x = 0.0
     H, dH = -1.0, 0.0
+    b, Hb = -1.0, 0.0
     if xguess > 0.0:
-        H, dH = _closure(xguess, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
-        if H > 0.0 and dH < 0.0:
-            x = xguess
+        Hg, dHg = _closure(xguess, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+        if Hg > 0.0 and dHg < 0.0:
+            x, H, dH = xguess, Hg, dHg
+        elif dHg < 0.0 and abs(Hg) <= ROUND * xguess:
+            return xguess, 0
+        elif Hg <= 0.0:
+            b, Hb = xguess, Hg
     if x == 0.0:
         H, dH = _closure(x, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
         if H <= 0.0:
             return 0.0, 0
-    for it in range(400):
-        if dH >= 0.0:
-            return x, 1
-        xn = x - H / dH
-        if xn - x <= 1e-13 * xn + tol:
-            return xn, 0  # (a fold would make the step large, not small)
-        cap = 2.0 * x + xmin
-        if xn > cap:
-            xn = cap
-        Hn, dHn = _closure(xn, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
-        if Hn > 0.0:
-            x, H, dH = xn, Hn, dHn
-            continue
-        a, Ha, dHa, b = x, H, dH, xn
-        for k in range(300):
-            if dHa >= 0.0:
-                return a, 1
-            xt = a - Ha / dHa
-            if not (a < xt < b):
-                xt = 0.5 * (a + b)
-            elif xt - a <= 1e-13 * xt + tol:
-                # Newton from the left (H is convex here, so it stays left of the root
-                # and b never moves): converged to round-off
+    if b < 0.0:
+        # from the left, no bound yet
+        xp, dHp = -1.0, 0.0
+        for it in range(400):
+            if dH >= 0.0:
+                return x, 1
+            newton = -H / dH
+            if _converged(newton, x, tol, dH):
+                return x + newton, 0
+            xn = x + newton
+            if xp >= 0.0 and x > xp:
+                xn = x + _quadratic_step(H, dH, 0.5 * (dH - dHp) / (x - xp))
+            cap = 2.0 * x + xmin
+            if xn > cap:
+                xn = cap
+            Hn, dHn = _closure(xn, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+            if Hn > 0.0:
+                xp, dHp = x, dH
+                x, H, dH = xn, Hn, dHn
+                continue
+            b, Hb = xn, Hn
+            break
+        if b < 0.0:
+            return x, 2
+    # in the bracket [a, b], H(a) > 0 >= H(b)
+    a, Ha, dHa = x, H, dH
+    for k in range(300):
+        if dHa >= 0.0:
+            return a, 1
+        newton = -Ha / dHa
+        if _converged(newton, a, tol, dHa):
+            return a + newton, 0
+        L = b - a
+        xt = a + _quadratic_step(Ha, dHa, (Hb - Ha - dHa * L) / (L * L))
+        if not (a < xt < b):
+            xt = 0.5 * (a + b)
+        Ht, dHt = _closure(xt, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
+        if Ht > 0.0:
+            a, Ha, dHa = xt, Ht, dHt
+        else:
+            b, Hb = xt, Ht
+            if -Ht <= ROUND * xt:
                 return xt, 0
-            Ht, dHt = _closure(xt, n, co, j0, nn, off, q, m, ylo, h, lam, zbar)
-            if Ht > 0.0:
-                a, Ha, dHa = xt, Ht, dHt
-            else:
-                b = xt
-            if b - a <= 1e-13 * b + tol or Ht == 0.0:
-                return b, 0
-        return b, 0
-    return x, 2
+        if b - a <= 1e-13 * b + tol:
+            return b, 0
+    return b, 0
 
 
 @njit(cache=True)
@@ -359,12 +411,18 @@ def deposit(dep, mass, ytop, B, W, lam, ylo, h):
         out = mass  # (only the part outside is lost; counted below)
         jlo = max(jlo, 0); jhi = min(jhi, ny - 1)
     tot = 0.0
+    # psi at the nodes j - 1, j, j + 1, each evaluated once
+    yj = ylo + jlo * h
+    p_lo = _psi(yj - h - ytop, B, W, lam)
+    p_mid = _psi(yj - ytop, B, W, lam)
     for j in range(jlo, jhi + 1):
         yj = ylo + j * h
-        w = (_psi(yj + h - ytop, B, W, lam) - 2.0 * _psi(yj - ytop, B, W, lam) + _psi(yj - h - ytop, B, W, lam)) / h
+        p_hi = _psi(yj + h - ytop, B, W, lam)
+        w = (p_hi - 2.0 * p_mid + p_lo) / h
         if w > 0.0:
             dep[j] += mass * w
             tot += w
+        p_lo, p_mid = p_mid, p_hi
     if out > 0.0:
         return mass * (1.0 - tot)
     return 0.0
