@@ -106,6 +106,39 @@ def test_the_cycles_trace_is_its_steps_stresses():
     assert mean == pytest.approx(row["sigma_mean"], abs=tiny)
 
 
+def test_step_roots_are_the_first_sign_change_of_the_closure_even_next_to_a_fold(monkeypatch):
+    """Every step's slip against the closure H itself, evaluated apart: H > 0 on a grid
+    below the returned root, and H changes sign within 1e-7 of the slip plus H's
+    round-off over its slope (H's round-off measured at 1e-18 in units of slip; 1e-16
+    allowed).  k0 = 1e-3 at 0.85 V^c, where each loading phase ends in a fold, so that
+    some roots are nearly double: the root finder steps to a parabola's zero there (Newton
+    from the left only halved the distance per evaluation) and stops at H's round-off (it
+    had bisected noise)."""
+    from micro import cohort
+    model = micro.Model(k0=1e-3)
+    V = 0.85 * micro.critical_velocity(model).Vc
+    st = _start(model, V, model.kappa * model.zbar / 5.0, None)
+    root = cohort._Cohorts.root
+    slopes = []
+
+    def checked_root(self, below=0.0):
+        x, status = root(self, below)
+        if status == 0 and x > 0.0:
+            H, dH = self.closure(x)
+            slack = 1e-7 * x + 1e-16 / abs(dH)
+            assert self.closure(x - slack)[0] > 0.0
+            assert self.closure(x + slack)[0] < 0.0
+            assert all(self.closure(y)[0] > 0.0 for y in np.linspace(0.0, x - slack, 9)[1:])
+            slopes.append(abs(dH))
+        return x, status
+
+    monkeypatch.setattr(cohort._Cohorts, "root", checked_root)
+    for _ in range(2):
+        assert _one_cycle(st, 0.004)["ok"]
+    # many roots, some next to a fold (slope below a twentieth of k0 / kappa, the state after a shock)
+    assert len(slopes) > 20 and min(slopes) < 0.05 * model.k0 / model.kappa
+
+
 @pytest.mark.parametrize("k0, frac", [(0.01, 0.5), (1e-4, 0.95)])
 def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
     """A step's Newton iteration starts from the slip rate of the steps before (the fold's
