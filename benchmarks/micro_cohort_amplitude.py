@@ -13,6 +13,10 @@ V / V^c, dt and h: ``--k0 0.01`` alone adds its rows).
     python benchmarks/micro_cohort_amplitude.py        # hours on 1 core (0.98-0.999 at dt = 0.005)
     python benchmarks/micro_cohort_amplitude.py --fractions 0.9,0.95,0.97,0.98,0.99,0.995 --dt 0.02
                                                        # k0 = 0.1: 16 minutes; 0.01: 1.5 minutes
+    python benchmarks/micro_cohort_amplitude.py --k0 0.1 --fractions 0.95,0.97,0.98,0.99,0.995 \
+        --dt 0.02,0.01 --tol 2e-5 --cold              # the k0 = 0.1 points near V^c again (2026-11-27)
+
+``--tol`` (default 1e-6) and ``--cold`` (each point from rest) are in the rows.
 """
 from __future__ import annotations
 
@@ -60,6 +64,9 @@ def main() -> None:
     ap.add_argument("--max-iter", type=int, default=400, help="cycles (and accelerated cycles) per point")
     ap.add_argument("--dt", default="0.01,0.005",
                     help="time steps, each with cells h = kappa zbar * dt * 5 (the default pairs)")
+    ap.add_argument("--tol", type=float, default=1e-6, help="the fixed points' tolerance in stress")
+    ap.add_argument("--cold", action="store_true",
+                    help="start each point from rest instead of from the previous V's cycle")
     ap.add_argument("--out", default=str(RESULTS / "micro_cohort_amplitude.csv"))
     args = ap.parse_args()
     out = Path(args.out)
@@ -75,10 +82,12 @@ def main() -> None:
             for dt in (float(v) for v in args.dt.split(",")):
                 h = 5.0 * lam * dt
                 sw = Stopwatch()
-                res = cycle_cohorts(model, V, dt=dt, h=h, tol=1e-6, start=starts.get(h), max_iter=args.max_iter)
+                res = cycle_cohorts(model, V, dt=dt, h=h, tol=args.tol, start=None if args.cold else starts.get(h),
+                                    max_iter=args.max_iter)
                 if res.applicable:
                     starts[h] = res  # (the next V continues from this cycle's whole state)
-                rows.append(dict(k0=k0, Vc=Vc, V_over_Vc=frac, V=V, dt=dt, h=h, sigma_max=res.sigma_max,
+                rows.append(dict(k0=k0, Vc=Vc, V_over_Vc=frac, V=V, dt=dt, h=h, tol=args.tol, cold=args.cold,
+                                 sigma_max=res.sigma_max,
                                  sigma_min=res.sigma_min, amplitude=res.sigma_max - res.sigma_min,
                                  period=res.period, unjumped=res.unjumped, error=res.error, cycles=res.iterations,
                                  converged=res.converged, applicable=res.applicable,
