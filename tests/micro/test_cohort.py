@@ -402,6 +402,21 @@ def test_tiny_steps_along_a_slow_mode_are_not_convergence():
     assert how[0] == "last steps" and errors[0] == pytest.approx(STILL * 1e-4 * (1 - m) * m ** 5, rel=1e-6)
 
 
+def test_an_extrapolation_does_not_claim_past_a_slow_mode_it_has_not_seen():
+    """Two modes, 0.96 and the model's slowest, 0.982 (a lone block's relaxation at k0 = 0.1,
+    0.98 V^c, where shocks leave 43 % of the blocks): five cycles show ratios of about 0.96,
+    and Aitken's extrapolation on them claimed 8e-7 where 7e-6 remained (at that point the
+    cohort method claimed 1.4e-5 where 3.9e-5 remained, docs/validation/micro_cohort.md
+    section 5).  With the slowest multiplier known, the claim covers the distance."""
+    from micro.cohort import _estimate
+    n = np.arange(13)
+    a = np.tile((0.9 - 1e-4 * 0.96 ** n - 3e-5 * 0.982 ** n)[:, None], (1, 4))
+    errors, how, best, _ = _estimate(a, 2e-5)
+    assert how[0] == "Aitken" and errors[0] < abs(best[0] - 0.9)  # (what the rule alone gives)
+    errors, how, best, _ = _estimate(a, 2e-5, 0.982)
+    assert how[0] == "Aitken" and errors[0] >= abs(best[0] - 0.9)
+
+
 def test_anderson_beats_the_plain_cycles_close_to_vc():
     # k0 = 0.01, 0.9 V^c: the cycle map contracts by about 0.96 per cycle; fifteen cycles'
     # worth of Anderson's acceleration leaves a smaller residual than fifteen plain cycles
