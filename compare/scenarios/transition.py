@@ -271,8 +271,8 @@ def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
                "memory factor of 0.72-0.92), and shocks stop being total below a crossover at d of about k0/k2, "
                "whose law is not derived, though at k0 = 0.1 it approaches a linear one as d falls (local exponent "
                "0.59 at the crossover, 0.88 at d = 0.002-0.005) (docs/reference/micro_transition.md, "
-               "docs/validation/micro_transition.md; a single power law is rejected at k0 = 0.1 and 0.01)" + (": fitted, " + "; ".join(said) if said else "; no amplitude law could be "
-                                       "fitted") + ".")
+               "docs/validation/micro_transition.md; a single power law is rejected at k0 = 0.1 and 0.01)"
+               + (": fitted, " + "; ".join(said) if said else "; no amplitude law could be fitted") + ".")
     if micro_div and rs_div:
         out.append("An exponent near 1/2 is therefore no evidence of a Hopf bifurcation.")
     nb = mf[mf.method == "N-block"] if len(mf) else mf
