@@ -6,7 +6,8 @@ the last one's whole state (``micro.cohort.cycle_cohorts(..., start=previous)``)
 chain's spectrum), so a cycle that converges there coexists with it (a subcritical
 onset); one that decays ends without a fixed point, its amplitude falling cycle by cycle,
 or with no shock at all.  Each row: the result, its error and message, and the amplitude
-of the first and last cycles the run made and their ratio per cycle.
+of the first and last cycles of the run's history (the cycles since its iteration last
+restarted: a new step or an acceleration clears it) and their ratio per cycle.
 
 Writes benchmarks/results/micro_cohort_above_vc.csv (rows merge by k0, V / V^c, dt).
 
