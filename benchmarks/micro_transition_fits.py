@@ -24,7 +24,7 @@ Checks of the derived relations (no fitted parameter):
 
 Fits, per k0, of ln A on ln d weighted by (error / A), with chi^2, its p-value and 95 %
 intervals (curve_fit, absolute sigma): power c d^beta; power times log c d^beta ln(1/d)^q;
-linear with an offset C (d + delta); a two-regime crossover c d^b_s (1 + d/d_x)^(b_l - b_s);
+linear times log c d ln(d0 / d); linear with an offset C (d + delta); a two-regime crossover c d^b_s (1 + d/d_x)^(b_l - b_s);
 and the derived two-regime form C (d + delta_c) (x / (x + x0))^p (1 - c2 d), x = d / delta_c,
 delta_c = 1 - V^c / V^c_r from the exact V^c (not fitted).
 
@@ -34,7 +34,13 @@ it where k0 = 1e-3 covers its d_r (``A_over_F_ref``), both at the default level 
 alone, unweighted (its discretisation error moves its points together): the change of a
 parameter between levels is its discretisation uncertainty.
 
-Writes ``micro_transition_points.csv`` and ``micro_transition_fits.csv``.  Seconds.
+Out of sample (k0 = 0.1): each law fitted to the dt = 0.02 level at d >= 0.01 and asked for
+that level's points below (the cold run at d = 0.005 and the continuation's at 0.005 and
+0.002, ``micro_cohort_above_vc.csv``).  And steady sliding's growth rate Lambda at each
+point (renewal chain): Lambda (b - 1) and Lambda T, T the cycle's period.
+
+Writes ``micro_transition_points.csv``, ``micro_transition_fits.csv`` and
+``micro_transition_predictions.csv``.  Seconds.
 
     python benchmarks/micro_transition_fits.py
 """
@@ -113,6 +119,9 @@ LAWS = {
     "power": (lambda d, lc, b: lc + b * np.log(d), ["ln_c", "beta"], [0.0, 0.7]),
     "power_log": (lambda d, lc, b, q: lc + b * np.log(d) + q * np.log(np.log(1.0 / d)), ["ln_c", "beta", "q"],
                   [0.0, 0.7, 0.0]),
+    # beta = q = 1 of power_log, with a scale: c d ln(d0 / d) (valid for d < d0)
+    "linear_log": (lambda d, lc, ld0: lc + np.log(d) + np.log(np.maximum(ld0 - np.log(d), 1e-300)), ["ln_c", "ln_d0"],
+                   [np.log(0.1), 0.0]),
     "linear_offset": (lambda d, lC, ld: lC + np.log(d + np.exp(ld)), ["ln_C", "ln_delta"], [np.log(0.15), -5.0]),
     "crossover": (lambda d, lc, bs, bl, ldx: lc + bs * np.log(d) + (bl - bs) * np.log1p(d / np.exp(ldx)),
                   ["ln_c", "beta_small", "beta_large", "ln_d_x"], [0.0, 0.7, 1.0, -4.0]),
@@ -164,7 +173,7 @@ def level_fits(pts_raw: pd.DataFrame) -> list[dict]:
         d, A = (1.0 - g.V_over_Vc).to_numpy(), g.amplitude.to_numpy()
         m = micro.Model(k0=k0)
         dc = 1.0 - float(g.Vc.iloc[0]) / (m.k2 * (m.k2 / m.eta_u) * m.zbar / m.k0) if len(g) else 0.0
-        for law in ("power", "power_log", "linear_offset", "crossover", "two_regime"):
+        for law in ("power", "power_log", "linear_log", "linear_offset", "crossover", "two_regime"):
             f, names, p0 = law_of(law, dc)
             dof = len(d) - len(names)
             row = dict(k0=k0, points=f"level dt = {dt:g}, unweighted", law=law, n=len(d),
@@ -250,6 +259,58 @@ def main() -> None:
         nu_e = np.hypot(e[1:] / A[1:], e[:-1] / A[:-1]) / np.log(d[1:] / d[:-1])
         print(f"k0 = {k0:g}: local exponents " + ", ".join(
             f"{a:g}-{b:g}: {v:.3f} +- {w:.3f}" for a, b, v, w in zip(d[:-1], d[1:], nu, nu_e)))
+    predictions(raw[raw.converged & raw.applicable & raw.error.notna()])
+    growth_clock(pts)
+
+
+def growth_clock(pts: pd.DataFrame) -> None:
+    """Steady sliding's growth rate Lambda against the cycle's loading time: Lambda (b - 1)
+    and Lambda T at the points' d (the renewal chain, milliseconds)."""
+    print("\nsteady sliding's growth rate against the cycle (renewal chain):")
+    for k0, grp in pts.groupby("k0", sort=False):
+        g = grp.sort_values("d", ascending=False)
+        m = micro.Model(k0=k0)
+        Vc = float(micro.critical_velocity(m).Vc)
+        st = micro.steady_sliding(m, list(Vc * (1.0 - g.d.to_numpy())))
+        for d, b, lam, T in zip(g.d, st.branching_ratio, st.growth_rate, g.period):
+            print(f"k0 = {k0:g}, d = {d:g}: b - 1 = {b - 1:.4g} ({(b - 1) / d:.4g} d), Lambda = {lam:.4g}, "
+                  f"Lambda (b - 1) = {lam * (b - 1):.3f}, Lambda T = {lam * T:.3g}")
+
+
+def predictions(raw: pd.DataFrame, k0: float = 0.1, dt: float = 0.02, d_fit: float = 0.01) -> None:
+    """Out of sample: each law fitted (unweighted) to one level's points with d >= d_fit,
+    then asked for that level's points below d_fit, the cold runs and the continuation
+    towards V^c (``micro_cohort_above_vc.csv``), none of which the fit saw.  Writes
+    ``micro_transition_predictions.csv``."""
+    lev = raw[(raw.k0 == k0) & np.isclose(raw.dt, dt)].assign(source="cold")
+    path = RESULTS / "micro_cohort_above_vc.csv"
+    if path.exists():
+        cont = pd.read_csv(path)
+        cont = cont[(cont.k0 == k0) & np.isclose(cont.dt, dt) & cont.converged].assign(source="continuation")
+        lev = pd.concat([lev, cont], ignore_index=True)
+    lev = lev.assign(d=1.0 - lev.V_over_Vc)
+    fit_pts = lev[(lev.source == "cold") & (lev.d >= d_fit - 1e-12) & (lev.d <= 0.1 + 1e-12)]
+    test = lev[lev.d < d_fit - 1e-12].sort_values("d", ascending=False)
+    if len(fit_pts) < 4 or not len(test):
+        return
+    m = micro.Model(k0=k0)
+    dc = 1.0 - float(micro.critical_velocity(m).Vc) / (m.k2 * (m.k2 / m.eta_u) * m.zbar / m.k0)
+    rows = []
+    for law in ("power", "power_log", "linear_log", "linear_offset", "two_regime"):
+        f, names, p0 = law_of(law, dc)
+        if len(fit_pts) <= len(names):
+            continue
+        p, _ = optimize.curve_fit(f, fit_pts.d.to_numpy(), np.log(fit_pts.amplitude.to_numpy()), p0=p0, maxfev=20000)
+        for _, t in test.iterrows():
+            pred = float(np.exp(f(np.array([t.d]), *p))[0])
+            rows.append(dict(k0=k0, dt=dt, law=law, fitted_d=f"{fit_pts.d.min():g}-{fit_pts.d.max():g}", d=t.d,
+                             source=t.source, amplitude=t.amplitude, error=t.error, predicted=pred,
+                             relative_miss=pred / t.amplitude - 1.0))
+    out = pd.DataFrame(rows)
+    write_csv(out, RESULTS / "micro_transition_predictions.csv")
+    print(f"\nout of sample, k0 = {k0:g}, dt = {dt:g}, fitted to d >= {d_fit:g}:")
+    print(out[["law", "d", "source", "amplitude", "predicted", "relative_miss"]].to_string(
+        index=False, float_format=lambda v: f"{v:.5g}"))
 
 
 if __name__ == "__main__":
