@@ -68,8 +68,11 @@ def summary(ctx, rep, paragraphs: Sequence[Sequence[str]]) -> str:
              f"them); its stick-slip cycles come from "
              + ("the cohort method (micro's default for cycles)" if s.cycle_method == "cohort"
                 else f"the Fokker-Planck equation at eps = {s.eps:g}")
-             + ", checked by the N-block simulation in the transition study; slide-hold-slide and the traces "
-             f"come from the Fokker-Planck equation at eps = {s.eps:g} (micro's only method for a transient).", ""]
+             + ", checked by the N-block simulation in the transition study; slide-hold-slide "
+             + ("and Fig. 3's fast traces come from the Fokker-Planck equation at eps = "
+                f"{s.eps:g} (micro's default for a transient), its slow trace from the N-block."
+                if s.paper_figures and "bifurcation" in s.scenarios else
+                f"comes from the Fokker-Planck equation at eps = {s.eps:g} (micro's default for a transient)."), ""]
     lines += _warnings(ctx, t)
     for paragraph in paragraphs:
         lines += paragraph
