@@ -46,6 +46,4 @@ def run_example(tmp_path, monkeypatch):
         return namespace, figures
 
     yield run
-    import matplotlib.pyplot as plt
-
     plt.close("all")
