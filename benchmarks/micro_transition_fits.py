@@ -34,9 +34,9 @@ it where k0 = 1e-3 covers its d_r (``A_over_F_ref``), both at the default level 
 alone, unweighted (its discretisation error moves its points together): the change of a
 parameter between levels is its discretisation uncertainty.
 
-Out of sample (k0 = 0.1): each law fitted to the dt = 0.02 level at d >= 0.01 and asked for
-that level's points below (the cold run at d = 0.005 and the continuation's at 0.005 and
-0.002, ``micro_cohort_above_vc.csv``).  And steady sliding's growth rate Lambda at each
+Out of sample: each law fitted to the dt = 0.02 level at d >= 0.01 (k0 = 0.1) or 0.02
+(k0 = 0.3) and asked for that level's points below (at k0 = 0.1 the cold run at d = 0.005
+and the continuation's at 0.005 and 0.002, ``micro_cohort_above_vc.csv``).  And steady sliding's growth rate Lambda at each
 point (renewal chain): Lambda (b - 1) and Lambda T, T the cycle's period.
 
 Writes ``micro_transition_points.csv``, ``micro_transition_fits.csv`` and
@@ -259,7 +259,11 @@ def main() -> None:
         nu_e = np.hypot(e[1:] / A[1:], e[:-1] / A[:-1]) / np.log(d[1:] / d[:-1])
         print(f"k0 = {k0:g}: local exponents " + ", ".join(
             f"{a:g}-{b:g}: {v:.3f} +- {w:.3f}" for a, b, v, w in zip(d[:-1], d[1:], nu, nu_e)))
-    predictions(raw[raw.converged & raw.applicable & raw.error.notna()])
+    ok = raw[raw.converged & raw.applicable & raw.error.notna()]
+    preds = [predictions(ok, k0=0.1, d_fit=0.01), predictions(ok, k0=0.3, d_fit=0.02)]
+    preds = [p for p in preds if len(p)]
+    if preds:
+        write_csv(pd.concat(preds, ignore_index=True), RESULTS / "micro_transition_predictions.csv")
     growth_clock(pts)
 
 
@@ -277,11 +281,10 @@ def growth_clock(pts: pd.DataFrame) -> None:
                   f"Lambda (b - 1) = {lam * (b - 1):.3f}, Lambda T = {lam * T:.3g}")
 
 
-def predictions(raw: pd.DataFrame, k0: float = 0.1, dt: float = 0.02, d_fit: float = 0.01) -> None:
-    """Out of sample: each law fitted (unweighted) to one level's points with d >= d_fit,
-    then asked for that level's points below d_fit, the cold runs and the continuation
-    towards V^c (``micro_cohort_above_vc.csv``), none of which the fit saw.  Writes
-    ``micro_transition_predictions.csv``."""
+def predictions(raw: pd.DataFrame, k0: float = 0.1, dt: float = 0.02, d_fit: float = 0.01) -> pd.DataFrame:
+    """Out of sample: each law fitted (unweighted) to one level's points with d >= d_fit
+    (and d <= 0.1), then asked for that level's points below d_fit, the cold runs and the
+    continuation towards V^c (``micro_cohort_above_vc.csv``), none of which the fit saw."""
     lev = raw[(raw.k0 == k0) & np.isclose(raw.dt, dt)].assign(source="cold")
     path = RESULTS / "micro_cohort_above_vc.csv"
     if path.exists():
@@ -291,8 +294,8 @@ def predictions(raw: pd.DataFrame, k0: float = 0.1, dt: float = 0.02, d_fit: flo
     lev = lev.assign(d=1.0 - lev.V_over_Vc)
     fit_pts = lev[(lev.source == "cold") & (lev.d >= d_fit - 1e-12) & (lev.d <= 0.1 + 1e-12)]
     test = lev[lev.d < d_fit - 1e-12].sort_values("d", ascending=False)
-    if len(fit_pts) < 4 or not len(test):
-        return
+    if len(fit_pts) < 3 or not len(test):
+        return pd.DataFrame()
     m = micro.Model(k0=k0)
     dc = 1.0 - float(micro.critical_velocity(m).Vc) / (m.k2 * (m.k2 / m.eta_u) * m.zbar / m.k0)
     rows = []
@@ -307,10 +310,10 @@ def predictions(raw: pd.DataFrame, k0: float = 0.1, dt: float = 0.02, d_fit: flo
                              source=t.source, amplitude=t.amplitude, error=t.error, predicted=pred,
                              relative_miss=pred / t.amplitude - 1.0))
     out = pd.DataFrame(rows)
-    write_csv(out, RESULTS / "micro_transition_predictions.csv")
     print(f"\nout of sample, k0 = {k0:g}, dt = {dt:g}, fitted to d >= {d_fit:g}:")
     print(out[["law", "d", "source", "amplitude", "predicted", "relative_miss"]].to_string(
         index=False, float_format=lambda v: f"{v:.5g}"))
+    return out
 
 
 if __name__ == "__main__":
