@@ -272,7 +272,7 @@ def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
                "shocks are total it depends on k0 V alone and is about linear in d (derived up to a measured "
                "memory factor of 0.72-0.92), and shocks stop being total below a crossover at d of about k0/k2, "
                "whose law is not derived, though it becomes linear as d falls: at k0 = 0.1 the local exponent rises "
-               "from 0.59 at the crossover to 0.88 at d = 0.002-0.005, and at k0 = 0.3 it is 1.00-1.02 from d = 0.02 "
+               "from 0.59 at the crossover to 0.88 at d = 0.002-0.005, and at k0 = 0.3 it is 1.01-1.06 from d = 0.02 "
                "to 0.005, A ≈ 0.25 d (docs/reference/micro_transition.md, "
                "docs/validation/micro_transition.md; a single power law is rejected at k0 = 0.1 and 0.01)"
                + (": fitted, " + "; ".join(said) if said else "; no amplitude law could be fitted") + ".")
