@@ -355,6 +355,30 @@ def fig3(t: dict[str, pd.DataFrame], path: Path) -> Path:
     return _save(fig, path)
 
 
+def fig10(t: dict[str, pd.DataFrame], path: Path) -> Path:
+    d = t["fig10_eps"]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for i, (k0, g) in enumerate(d.groupby("k0", sort=False)):
+        g = g.sort_values("eps")
+        ok = _converged(g)
+        c = _color(k0, i)
+        ax.loglog(g.eps, np.abs(g.error), "-", color=c, lw=0.7)
+        e = np.abs(g.error[ok].to_numpy())
+        order = (f", order {np.polyfit(np.log(g.eps[ok]), np.log(e), 1)[0]:.2f}"
+                 if ok.sum() >= 2 and (e > 0).all() else "")
+        ax.loglog(g.eps[ok], e, "o", color=c, label=f"k0 = {k0:g}, V = {g.V.iloc[0]:.3g}{order}")
+        ax.loglog(g.eps[~ok], np.abs(g.error[~ok]), "o", color=c, mfc="none")
+    eps = np.sort(d.eps.unique())
+    ax.set_xticks(eps, [f"{e:g}" for e in eps])
+    ax.xaxis.set_minor_locator(plt.NullLocator())
+    ax.set_xlabel("bin eps")
+    ax.set_ylabel("|sigma_FP - sigma_exact|")
+    ax.set_title("Fig. 10: the FP's stress against the bin, V = 1.5 V^c (exact: direct method)\n"
+                 "open: not converged (a grid oscillation persists; order fitted on the filled points)", fontsize=8)
+    ax.legend(fontsize=7)
+    return _save(fig, path)
+
+
 def target(out, name: str):
     """Where a figure ``name`` goes in the folder ``out``: a
     :class:`~compare.output.ReportFolder` (written atomically) or a plain path."""

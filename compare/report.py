@@ -1,7 +1,7 @@
 r"""The whole comparison: micro and RS side by side, as tables, figures and ``summary.md``.
 
 :func:`report` runs the scenarios of a :class:`~compare.params.Settings` (``bifurcation``,
-``hopf``, ``phase``, ``shs``, and the paper's Fig. 3 with ``paper_figures``) and
+``hopf``, ``phase``, ``shs``, and the paper's Figs. 3 and 10 with ``paper_figures``) and
 returns a :class:`Report` whose tables are pandas DataFrames; with ``out`` it also writes
 them as CSV, the figures as PNG and a summary.
 
@@ -12,7 +12,8 @@ transition study are limit cycles solved as fixed points of the cycle map
 (:mod:`micro.cohort`, seconds per point at every k0, each with its discretisation error
 where it is known), checked in the transition study by the N-block simulation at two
 sizes; slide-hold-slide and the paper's fast traces time-step the Fokker-Planck equation
-(a method that carries a transient), its slow trace the N-block.
+(a method that carries a transient), its slow trace the N-block, and the paper's Fig. 10 is
+the FP against its bin.
 
 The code is in three layers:
 
@@ -135,7 +136,7 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
         Folder for PNG figures, CSV tables and ``summary.md`` (created).
     scenarios : sequence of str, optional
         Subset of ``('bifurcation', 'hopf', 'phase', 'shs')``; default ``settings.scenarios``.
-        (The paper's Fig. 3 comes with ``bifurcation`` when ``settings.paper_figures``.)
+        (The paper's Figs. 3 and 10 come with ``bifurcation`` when ``settings.paper_figures``.)
     Dc : float, optional
         Use this D_c instead of fitting it to the stick-slip extrema (D_c from V^c
         matching is still reported).

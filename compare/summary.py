@@ -70,7 +70,8 @@ def summary(ctx, rep, paragraphs: Sequence[Sequence[str]]) -> str:
                 else f"the Fokker-Planck equation at eps = {s.eps:g}")
              + ", checked by the N-block simulation in the transition study; slide-hold-slide "
              + ("and Fig. 3's fast traces come from the Fokker-Planck equation at eps = "
-                f"{s.eps:g} (micro's default for a transient), its slow trace from the N-block."
+                f"{s.eps:g} (micro's default for a transient), its slow trace from the N-block; Fig. 10 is the "
+                "Fokker-Planck equation against its bin."
                 if s.paper_figures and "bifurcation" in s.scenarios else
                 f"comes from the Fokker-Planck equation at eps = {s.eps:g} (micro's default for a transient)."), ""]
     lines += _warnings(ctx, t)

@@ -9,7 +9,7 @@ module                 name               what it compares
                                           amplitudes (cohort, N-block) against RS's Hopf
 :mod:`.phase`          ``phase``          Fig. 5: V^c(k0) per (k1, k2) set
 :mod:`.shs`            ``shs``            Fig. 7: slide-hold-slide peaks and growth laws
-:mod:`.paper`          ``paper``          Fig. 3 (``paper_figures``, with the
+:mod:`.paper`          ``paper``          Figs. 3 and 10 (``paper_figures``, with the
                                           bifurcation scenario)
 =====================  =================  ====================================================
 

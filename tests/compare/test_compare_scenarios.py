@@ -51,17 +51,22 @@ def test_a_registered_scenario_joins_the_report_and_models_are_built_once(quick_
     assert built and max(built.values()) == 1, built.most_common(3)
 
 
-def test_the_paper_preset_has_no_figure_10():
-    """The paper's Fig. 10 left the report (its runs could not resolve the FP's error in a
-    report's time): no FP stationary task in the paper scenario, and its settings are gone
-    with a clear error."""
+def test_the_paper_figure_10_runs_stop_at_their_time_budget():
+    """Fig. 10's FP runs carry ``fig10_t_max`` as their stopping time (and so in their
+    cache key); every other micro task keeps the report's stopping rule."""
     paper = importlib.import_module("compare.scenarios.paper")
-    settings = compare.Settings.paper()
-    ctx = SimpleNamespace(s=settings, Vc=lambda k0: 1.0, model=settings.model)
-    assert all(isinstance(t, compare.tasks.TraceTask) for t in paper.tasks(ctx))
-    assert paper.vc_k0(ctx) == []
-    with pytest.raises(TypeError, match="fig10_t_max"):
-        compare.Settings.paper(fig10_t_max=50.0)
+    settings = compare.Settings.paper(fig10_t_max=50.0)
+    ctx = SimpleNamespace(s=settings, Vc=lambda k0: 1.0, model=settings.model,
+                          stationary_task=lambda k0, V, eps, method: compare.tasks.StationaryTask(
+                              settings.model(k0), V, settings.numerics(eps), settings.convergence(), method))
+    tasks = paper._fig10_tasks(ctx)
+    assert len(tasks) == 8
+    assert {t.convergence.t_max for t in tasks} == {50.0}
+    assert {t.method for t in tasks} == {"fp"} and settings.convergence().t_max is None
+    assert compare.Settings.paper().fig10_t_max == 120.0
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="^fig10_t_max must be"):
+            compare.Settings.paper(fig10_t_max=bad)
 
 
 def test_the_paper_figure_3_traces_are_by_the_method_that_carries_each_transient_cheaply():
