@@ -57,11 +57,16 @@ from _harness import RESULTS, write_csv
 FLOOR = 5e-5
 
 
+def reset_vc(model: micro.Model) -> float:
+    """The reset model's critical velocity V^c_r = k2 gamma zbar / k0 (gamma = k2 / eta_u)."""
+    return model.k2 * (model.k2 / model.eta_u) * model.zbar / model.k0
+
+
 def reset_time(model: micro.Model, V: float) -> float:
     """Loading time of the reset model: the root t > 0 of k2 zbar (1 - e^{-gamma t}) = k0 V t
     (NaN at V >= V^c_r = k2 gamma zbar / k0, where there is none)."""
     g = model.k2 / model.eta_u
-    q = V / (model.k2 * g * model.zbar / model.k0)
+    q = V / reset_vc(model)
     if q >= 1.0:
         return float("nan")
     tau = optimize.brentq(lambda t: -np.expm1(-t) / t - q, 1e-14, 1e4, xtol=1e-15)
@@ -101,7 +106,7 @@ def points() -> pd.DataFrame:
         m = micro.Model(k0=p.k0)
         lam = m.kappa * m.zbar
         gam = m.k2 / m.eta_u
-        vcr = m.k2 * gam * m.zbar / m.k0
+        vcr = reset_vc(m)
         S = (m.k1 + m.k2) * p.amplitude / (m.k0 * lam)
         Tr = reset_time(m, p.V)
         c = 1.0 - m.k2 / m.kappa * -np.expm1(-gam * p.period)  # the loading's contraction of the margins
@@ -172,7 +177,7 @@ def level_fits(pts_raw: pd.DataFrame) -> list[dict]:
         g = grp[(1.0 - grp.V_over_Vc) <= 0.1 + 1e-12]
         d, A = (1.0 - g.V_over_Vc).to_numpy(), g.amplitude.to_numpy()
         m = micro.Model(k0=k0)
-        dc = 1.0 - float(g.Vc.iloc[0]) / (m.k2 * (m.k2 / m.eta_u) * m.zbar / m.k0) if len(g) else 0.0
+        dc = 1.0 - float(g.Vc.iloc[0]) / reset_vc(m) if len(g) else 0.0
         for law in ("power", "power_log", "linear_log", "linear_offset", "crossover", "two_regime"):
             f, names, p0 = law_of(law, dc)
             dof = len(d) - len(names)
@@ -273,9 +278,7 @@ def growth_clock(pts: pd.DataFrame) -> None:
     print("\nsteady sliding's growth rate against the cycle (renewal chain):")
     for k0, grp in pts.groupby("k0", sort=False):
         g = grp.sort_values("d", ascending=False)
-        m = micro.Model(k0=k0)
-        Vc = float(micro.critical_velocity(m).Vc)
-        st = micro.steady_sliding(m, list(Vc * (1.0 - g.d.to_numpy())))
+        st = micro.steady_sliding(micro.Model(k0=k0), list(g.V))
         for d, b, lam, T in zip(g.d, st.branching_ratio, st.growth_rate, g.period):
             print(f"k0 = {k0:g}, d = {d:g}: b - 1 = {b - 1:.4g} ({(b - 1) / d:.4g} d), Lambda = {lam:.4g}, "
                   f"Lambda (b - 1) = {lam * (b - 1):.3f}, Lambda T = {lam * T:.3g}")
@@ -296,8 +299,7 @@ def predictions(raw: pd.DataFrame, k0: float = 0.1, dt: float = 0.02, d_fit: flo
     test = lev[lev.d < d_fit - 1e-12].sort_values("d", ascending=False)
     if len(fit_pts) < 3 or not len(test):
         return pd.DataFrame()
-    m = micro.Model(k0=k0)
-    dc = 1.0 - float(micro.critical_velocity(m).Vc) / (m.k2 * (m.k2 / m.eta_u) * m.zbar / m.k0)
+    dc = 1.0 - float(fit_pts.Vc.iloc[0]) / reset_vc(micro.Model(k0=k0))
     rows = []
     for law in ("power", "power_log", "linear_log", "linear_offset", "two_regime"):
         f, names, p0 = law_of(law, dc)
