@@ -23,14 +23,17 @@ Writes ``benchmarks/results/micro_fp_fig10_long.csv`` (one row per (k0, eps, win
     python benchmarks/micro_fp_fig10_long.py
     python benchmarks/micro_fp_fig10_long.py --k0 0.1 --eps 0.025 --duration 240
     python benchmarks/micro_fp_fig10_long.py --plot-only
+    python benchmarks/micro_fp_fig10_long.py --check-report 60,120   # the report's runs against these
 """
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 
+import compare
 import micro
 from micro.analysis import Records
 from _harness import FIGURES, RESULTS, Stopwatch, pyplot, save_figure, warm_up, write_csv
@@ -53,9 +56,14 @@ def main() -> None:
     ap.add_argument("--duration", type=float, default=480.0)
     ap.add_argument("--settle", type=float, default=120.0, help="windows from this time on make the late mean")
     ap.add_argument("--plot-only", action="store_true", help="redraw the figure from the CSV")
+    ap.add_argument("--check-report", metavar="T_MAX", help="instead: the report's runs (the FP's stopping rule, "
+                    "stopped at each of these t_max) against the long runs' late means in the CSV")
     args = ap.parse_args()
     if args.plot_only:
         draw(pd.read_csv(RESULTS / "micro_fp_fig10_long.csv"))
+        return
+    if args.check_report:
+        check_report([float(x) for x in args.check_report.split(",")], args)
         return
     windows = [w for w in WINDOWS if w[1] <= args.duration]
     warm_up(lambda: micro.simulate(micro.Model(k0=0.1), 1.0, duration=0.5, numerics=micro.FP(eps=0.025)))
@@ -80,6 +88,39 @@ def main() -> None:
                   f"{sw.seconds:.1f} s", flush=True)
     table = write_csv(pd.DataFrame(rows), RESULTS / "micro_fp_fig10_long.csv", keys=["k0", "eps", "window"])
     draw(table)
+
+
+def check_report(t_maxes: list[float], args) -> None:
+    """The report's Fig. 10 runs (``micro.stationary(method="fp")`` with the report's
+    stopping rule, ``compare.Settings.paper().convergence()``, cut at ``t_max``; an unsettled grid-sized oscillation reports its time mean over
+    the run's later half) against the long runs' late means.  Writes
+    ``benchmarks/results/micro_fp_fig10_report_check.csv``."""
+    late = pd.read_csv(RESULTS / "micro_fp_fig10_long.csv")
+    late = late[late.window == "late"].set_index(["k0", "eps"])
+    warm_up(lambda: micro.stationary(micro.Model(k0=0.1), 1.2, method="fp", numerics=micro.FP(eps=0.025),
+                                     convergence=micro.Convergence(t_max=2.0), warn=False))
+    report = compare.Settings.paper()
+    rows = []
+    for t_max in t_maxes:
+        for k0 in (float(x) for x in args.k0.split(",")):
+            model = micro.Model(k0=k0)
+            V = float(f"{1.5 * float(micro.critical_velocity(model).Vc):.6g}")
+            for eps in (float(x) for x in args.eps.split(",")):
+                with Stopwatch() as sw:
+                    r = micro.stationary(model, V, method="fp", numerics=report.numerics(eps),
+                                         convergence=replace(report.convergence(), t_max=t_max), warn=False)
+                ref = late.loc[(k0, eps)]
+                rows.append(dict(t_max=t_max, k0=k0, V=V, eps=eps, t_end=r.t_end, converged=r.converged,
+                                 regime=r.regime, error=r.sigma_mean - ref.exact, long_error=ref.error,
+                                 report_minus_long=r.sigma_mean - ref.sigma, long_half_range=ref.half_range,
+                                 wall_s=sw.seconds))
+                print(f"t_max = {t_max:g}, k0 = {k0:g}, eps = {eps:g}: stopped at t = {r.t_end:.1f} "
+                      f"({'settled' if r.converged else 'open'}, {r.regime}), error {rows[-1]['error']:+.2e}, "
+                      f"report - long {rows[-1]['report_minus_long']:+.1e}; {sw.seconds:.1f} s", flush=True)
+    table = write_csv(pd.DataFrame(rows), RESULTS / "micro_fp_fig10_report_check.csv", keys=["t_max", "k0", "eps"])
+    for t_max, g in table.groupby("t_max"):
+        print(f"t_max = {t_max:g}: max |report - long| {g.report_minus_long.abs().max():.1e}, "
+              f"summed wall {g.wall_s.sum():.1f} s")
 
 
 def draw(table: pd.DataFrame) -> None:

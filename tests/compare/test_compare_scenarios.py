@@ -63,7 +63,7 @@ def test_the_paper_figure_10_runs_stop_at_their_time_budget():
     assert len(tasks) == 8
     assert {t.convergence.t_max for t in tasks} == {50.0}
     assert {t.method for t in tasks} == {"fp"} and settings.convergence().t_max is None
-    assert compare.Settings.paper().fig10_t_max == 120.0
+    assert compare.Settings.paper().fig10_t_max == 60.0
     for bad in (0.0, -1.0, float("nan")):
         with pytest.raises(ValueError, match="^fig10_t_max must be"):
             compare.Settings.paper(fig10_t_max=bad)

@@ -238,6 +238,31 @@ def test_a_persisting_unconverged_oscillation_of_grid_size_is_flagged(drop_in_k0
     assert out["sigma_max"] - out["sigma_min"] == pytest.approx(drop_in_k0_eps * jitter, rel=1e-3)
 
 
+@pytest.mark.parametrize("drop_in_k0_eps, flagged", [(4.0, True), (40.0, False)])
+def test_a_grid_sized_oscillation_reports_the_later_half_time_mean(drop_in_k0_eps, flagged):
+    # The grid's oscillation is irregular: its mean stress is the time mean over the run's
+    # later half (t = 50-100 here), not the mean of its last three peaks; a real cycle
+    # keeps its last three cycles' mean.  A slow wander (period 37) tells the two apart.
+    from micro import _fp_kernels as K
+    from micro.analysis import Records, find_cycles
+
+    jitter = 1e-3
+    t = np.linspace(0.0, 100.0, 200001)
+    slow = 2.0 * jitter
+    s = 0.9 + 0.5 * drop_in_k0_eps * jitter * np.sin(2.0 * np.pi * t / 5.0) + slow * np.sin(2.0 * np.pi * t / 37.0)
+    rec = Records.from_array(np.column_stack([t, s, s, s, s]))
+    cycles = find_cycles(rec, 2.0 * jitter)
+    _, message, out = solver._unconverged(rec, cycles, 2.0 * jitter, 100.0, 5.0, 100.0, 100.0, K.DONE,
+                                          load_rate=1e-3, grid_limit=10.0 * jitter)
+    w = 2.0 * np.pi / 37.0
+    half_mean = 0.9 + slow * (math.cos(50.0 * w) - math.cos(100.0 * w)) / (50.0 * w)
+    last_three = float(cycles.sigma_mean.iloc[-3:].mean())
+    assert abs(half_mean - last_three) > 0.3 * slow
+    expected = half_mean if flagged else last_three
+    assert out["sigma_mean"] == pytest.approx(expected, abs=1e-3 * slow)
+    assert ("later half" in message) == flagged
+
+
 def test_a_fluctuating_cycle_is_not_a_decaying_one():
     # 40 cycles of a limit cycle whose amplitude fluctuates by ~1 % (the grid), ending
     # on three falling values: the last-three ratio alone said "decays".
