@@ -28,7 +28,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="compare-report", help="report folder (created; default: %(default)s)")
     preset = p.add_mutually_exclusive_group()
     preset.add_argument("--quick", action="store_true", help="smoke-test preset: few coarse points (~15 s)")
-    preset.add_argument("--paper", action="store_true", help="more points, finer N-block, Figs. 3 and 10 (~4 min on 2 cores)")
+    preset.add_argument("--paper", action="store_true", help="more points, finer N-block, Figs. 3 and 10 (~2 min on 2 cores)")
     p.add_argument("--scenario", action="append", choices=SCENARIOS, metavar="NAME",
                    help=f"run only this scenario (repeatable): {', '.join(SCENARIOS)}; default all")
     p.add_argument("--k0", type=float, nargs="+", metavar="K0",

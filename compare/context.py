@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import logging
 import math
-from functools import cached_property
+from functools import cached_property, partial
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -325,6 +325,7 @@ class Context:
         if self.Dc_given is not None:
             return None
         pts = self.micro_points
+        self._per_k0_fits  # started: the per-k0 fits run on the pool's workers meanwhile
         fit = fits.fit_dc(pts, self.law_for, bounds=self.s.dc_bounds, n_grid=self.s.dc_grid,
                           n_bootstrap=self.s.bootstrap)
         self.tables["dc_fit"] = fit.to_frame()
@@ -342,12 +343,18 @@ class Context:
         beside D_c (b) at that k0 (the fitted law's slope at micro's exact V^c): how far one
         D_c is from carrying every k0.  Columns ``k0, n_points, Dc_a, Dc_a_lo, Dc_a_hi``
         (the profile interval), ``rms_a``, ``Dc_b``, ``ratio_a_b``."""
-        pts = self.micro_points
         per_b = self.dc_critical.per_k0.set_index("k0").Dc_law
         rows = []
-        for k0, grp in pts.groupby("k0", sort=False):
+        for k0, grp, future in self._per_k0_fits:
             try:
-                fit = fits.fit_dc(grp, self.law_for, bounds=self.s.dc_bounds, n_grid=self.s.dc_grid, n_bootstrap=0)
+                try:
+                    fit = future.result()
+                except ValueError:
+                    raise
+                except Exception as exc:  # noqa: BLE001 - the worker's failure, not the fit's: fit here
+                    log.warning("D_c (a) at k0 = %g alone failed on a worker (%s); fitting it here", k0, exc)
+                    fit = fits.fit_dc(grp, self.law_for, bounds=self.s.dc_bounds, n_grid=self.s.dc_grid,
+                                      n_bootstrap=0)
             except ValueError as exc:  # (fewer than 3 usable points at this k0)
                 log.warning("D_c (a) at k0 = %g alone: %s", k0, exc)
                 continue
@@ -358,6 +365,17 @@ class Context:
         frame = pd.DataFrame(rows).sort_values("k0", ascending=False, ignore_index=True) if rows else pd.DataFrame()
         self.tables["dc_per_k0"] = frame
         return frame
+
+    @cached_property
+    def _per_k0_fits(self) -> list[tuple[float, pd.DataFrame, Any]]:
+        """The fits of :attr:`dc_per_k0`: (k0, its points, a future of its fit) per k0,
+        started on the pool's workers (:meth:`Runner.submit`) while this process fits D_c (a)
+        to every k0 (with the laws as a dict: this context does not travel)."""
+        pts = self.micro_points
+        laws = {float(k0): self.law_for(float(k0)) for k0 in pts.k0.unique()}
+        fit = partial(fits.fit_dc, bounds=self.s.dc_bounds, n_grid=self.s.dc_grid, n_bootstrap=0)
+        return [(float(k0), grp, self.runner.submit(fit, grp, laws.__getitem__))
+                for k0, grp in pts.groupby("k0", sort=False)]
 
     @cached_property
     def dc_critical(self) -> fits.DcCriticalFit:

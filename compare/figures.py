@@ -8,9 +8,15 @@ them.
 """
 from __future__ import annotations
 
+import functools
+import logging
 import math
+import os
+import pickle
+import tempfile
+from concurrent.futures import Future
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import matplotlib
 
@@ -23,9 +29,88 @@ from micro.api import NEAR_VC  # noqa: E402
 
 from . import fits  # noqa: E402
 
-__all__ = ["target"]
+__all__ = ["Painter", "target"]
+
+log = logging.getLogger(__name__)
 
 _COLORS = {0.3: "C0", 0.1: "C1", 0.01: "C2", 0.001: "C3", 0.0001: "C4"}
+
+
+class Painter:
+    """Draws a report's figures on other processes while the caller goes on.
+
+    Pass it where a figure function takes its folder (``figures.target(painter, name)``):
+    the call then hands the figure's data to ``submit`` (:meth:`compare.Runner.submit`:
+    a worker of the runner's pool, or this process) and returns the figure's final path
+    at once.  Each figure is drawn into a temporary file of the folder, and
+    :meth:`finish` waits for them and writes each into the folder
+    (:meth:`ReportFolder.write`, atomically).  A figure whose worker failed is drawn
+    again here, so that its error, if it is the figure's own, is raised from this process."""
+
+    def __init__(self, folder, submit: Callable) -> None:
+        self.folder = folder
+        self._submit = submit
+        self._jobs: list[tuple[str, Path, str, tuple, Any]] = []
+
+    def write(self, name: str, write: Callable[[Path], None]) -> Path:
+        """As :meth:`ReportFolder.write` (so that :func:`target` takes a painter for a folder)."""
+        return self.folder.write(name, write)
+
+    def submit(self, fn_name: str, data: tuple, name: str) -> Path:
+        """Draw ``fn_name(*data, path)`` into the folder's file ``name``; its final path."""
+        try:
+            blob = pickle.dumps((fn_name, data), protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception:  # noqa: BLE001 - data that cannot travel: draw it here
+            return globals()[fn_name].__wrapped__(*data, (self.folder, name))
+        fd, tmp = tempfile.mkstemp(dir=self.folder.path, prefix=f".{name}.", suffix=".png")
+        os.close(fd)
+        try:
+            future = self._submit(_paint, blob, tmp)
+        except Exception as exc:  # noqa: BLE001 - (a broken pool): drawn here by finish()
+            future = Future()
+            future.set_exception(exc)
+        self._jobs.append((name, Path(tmp), fn_name, data, future))
+        return self.folder.path / name
+
+    def finish(self) -> None:
+        """Wait for every figure and write it into the folder; temporary files are removed
+        whatever happens."""
+        try:
+            for name, tmp, fn_name, data, fut in self._jobs:
+                try:
+                    fut.result()
+                except Exception as exc:  # noqa: BLE001 - redrawn here, where its own error surfaces
+                    log.warning("figure %s failed on a worker (%s); drawing it here", name, exc)
+                    globals()[fn_name].__wrapped__(*data, tmp)
+                self.folder.write(name, lambda p, tmp=tmp: os.replace(tmp, p))
+        finally:
+            self.discard()
+
+    def discard(self) -> None:
+        """Forget the figures not yet written and remove their temporary files."""
+        for _, tmp, _, _, fut in self._jobs:
+            fut.cancel()
+            tmp.unlink(missing_ok=True)
+        self._jobs.clear()
+
+
+def _paint(blob: bytes, tmp: str) -> str:
+    """A :class:`Painter`'s job on a worker: draw the figure into the file ``tmp``."""
+    fn_name, data = pickle.loads(blob)
+    globals()[fn_name].__wrapped__(*data, Path(tmp))
+    return tmp
+
+
+def _figure(fn: Callable) -> Callable:
+    """A figure function (its last argument the path): with a :class:`Painter` for the
+    folder, drawn by the painter."""
+    @functools.wraps(fn)
+    def draw(*args: Any) -> Path:
+        *data, path = args
+        if isinstance(path, tuple) and isinstance(path[0], Painter):
+            return path[0].submit(fn.__name__, tuple(data), path[1])
+        return fn(*args)
+    return draw
 
 
 def _save(fig, path) -> Path:
@@ -55,6 +140,7 @@ def _converged(frame: pd.DataFrame) -> np.ndarray:
     return frame.converged.fillna(False).astype(bool).to_numpy()
 
 
+@_figure
 def bifurcation(t: dict[str, pd.DataFrame], Dc: float, fp_k0, path: Path) -> Path:
     """Figs. 4 and 8: micro (left: exact steady branch, stick-slip points: those the D_c
     fit matches and those only shown) and RS with the fitted law and D_c (right), shared
@@ -119,6 +205,7 @@ def bifurcation(t: dict[str, pd.DataFrame], Dc: float, fp_k0, path: Path) -> Pat
     return _save(fig, path)
 
 
+@_figure
 def steady_fit(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
     """Fig. 6 (micro's velocity weakening, exact, log-log) and the Eq. (10) residual."""
     b = t["micro_branch"]
@@ -149,6 +236,7 @@ def steady_fit(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -
     return _save(fig, path)
 
 
+@_figure
 def dc_profile(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
     prof = t["dc_profile"]
     fig, ax = plt.subplots(figsize=(6.5, 4.3))
@@ -176,6 +264,7 @@ def dc_profile(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -
     return _save(fig, path)
 
 
+@_figure
 def critical_velocity(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
     """V^c(k0): micro exact against RS with each D_c (and the paper's law)."""
     cur, crit = t["vc_curves"], t["critical_velocity"]
@@ -196,6 +285,7 @@ def critical_velocity(t: dict[str, pd.DataFrame], values: dict[str, Any], path: 
     return _save(fig, path)
 
 
+@_figure
 def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
     """The transition on both sides.  Left: the one test, the growth rate of the unstable
     mode of steady sliding against d = (V^c - V)/V^c (micro's, and RS's at a = 0 where
@@ -285,6 +375,7 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     return _save(fig, path)
 
 
+@_figure
 def phase(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
     rs, mic, laws = t["phase_rs"], t["phase_micro"], t["phase_laws"]
     sets = list(laws[["k1", "k2"]].itertuples(index=False, name=None))
@@ -308,6 +399,7 @@ def phase(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Pat
     return _save(fig, path)
 
 
+@_figure
 def shs(t: dict[str, pd.DataFrame], path: Path) -> Path:
     pts, fit = t["shs_points"], t["shs_fit"]
     trace = t.get("shs_trace")
@@ -343,6 +435,7 @@ def shs(t: dict[str, pd.DataFrame], path: Path) -> Path:
     return _save(fig, path)
 
 
+@_figure
 def fig3(t: dict[str, pd.DataFrame], path: Path) -> Path:
     d = t["fig3_traces"]
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
@@ -355,6 +448,7 @@ def fig3(t: dict[str, pd.DataFrame], path: Path) -> Path:
     return _save(fig, path)
 
 
+@_figure
 def fig10(t: dict[str, pd.DataFrame], path: Path) -> Path:
     d = t["fig10_eps"]
     fig, ax = plt.subplots(figsize=(6, 4))

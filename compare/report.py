@@ -25,7 +25,9 @@ The code is in three layers:
 * this module: :data:`REGISTRY` of the scenarios, and :func:`report`, which runs every
   micro task of the selected scenarios in two batches on the runner (first the exact V^c
   that the other tasks are placed at, then everything else at once, the slowest first,
-  so that the pool stays busy), then each scenario, and assembles the report.
+  so that the pool stays busy), then each scenario, and assembles the report (the
+  per-k0 D_c fits and the figures on the pool's workers, idle by then:
+  :meth:`~compare.runner.Runner.submit`, :class:`~compare.figures.Painter`).
 
 Every micro evaluation goes through a :class:`~compare.runner.Runner` (disk cache,
 process pool or dask); the RS side is fast and recomputed each time.
@@ -40,6 +42,7 @@ from typing import Any, Sequence
 
 import pandas as pd
 
+from . import figures
 from ._validation import positive
 from .cache import NullCache, PointCache
 from .context import SHARED_FIGURES, Context, micro_frame
@@ -183,33 +186,41 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
     cache = PointCache(cache_dir) if use_cache else NullCache()
     rep = Report(settings=settings)
     selected = [sc for sc in REGISTRY if sc.wanted(settings)]
-    with Runner(cache, workers=workers, scheduler=scheduler, progress=progress) as runner:
-        ctx = Context(settings, runner, Dc)
-        _prefetch(ctx, selected)
-        parts = []
-        for sc in selected:
-            log.info("scenario %s", sc.NAME)
-            parts.append((sc, sc.run(ctx)))
-        rep.stats = runner.stats
-    rep.tables, rep.values = dict(ctx.tables), dict(ctx.values)
-    for _, part in parts:
-        rep.tables.update(part.tables)
-        rep.values.update(part.values)
-    rep.tables["settings"] = pd.DataFrame([{k: repr(v) if isinstance(v, tuple) else v
-                                            for k, v in settings.to_dict().items()}])
-    # the shared stages' figures and D_c paragraph come first, unless a scenario shows them
-    presented = {name for sc, _ in parts for name in getattr(sc, "PRESENTS", ())}
-    folder = None
-    if out is not None:
-        folder = ReportFolder(Path(out))
-        rep.out = folder.path
-        for name, table in rep.tables.items():
-            folder.write(f"{name}.csv", lambda p, t=table: t.to_csv(p, index=False))
-        drawn: dict[str, Path] = {}
-        for sc, part in parts:
-            drawn.update(sc.draw(ctx, part, folder))
-        shared = {name: ctx.figure(name, folder) for name in SHARED_FIGURES if name not in presented}
-        rep.figures = {**{k: p for k, p in shared.items() if p is not None}, **drawn}
+    folder = painter = None
+    try:
+        with Runner(cache, workers=workers, scheduler=scheduler, progress=progress) as runner:
+            ctx = Context(settings, runner, Dc)
+            _prefetch(ctx, selected)
+            parts = []
+            for sc in selected:
+                log.info("scenario %s", sc.NAME)
+                parts.append((sc, sc.run(ctx)))
+            rep.stats = runner.stats
+            rep.tables, rep.values = dict(ctx.tables), dict(ctx.values)
+            for _, part in parts:
+                rep.tables.update(part.tables)
+                rep.values.update(part.values)
+            rep.tables["settings"] = pd.DataFrame([{k: repr(v) if isinstance(v, tuple) else v
+                                                    for k, v in settings.to_dict().items()}])
+            # the shared stages' figures and D_c paragraph come first, unless a scenario shows them
+            presented = {name for sc, _ in parts for name in getattr(sc, "PRESENTS", ())}
+            if out is not None:
+                folder = ReportFolder(Path(out))
+                rep.out = folder.path
+                # the figures are drawn on the pool's workers (warm, idle by now) while this
+                # process writes the tables
+                painter = figures.Painter(folder, runner.submit)
+                drawn: dict[str, Path] = {}
+                for sc, part in parts:
+                    drawn.update(sc.draw(ctx, part, painter))
+                shared = {name: ctx.figure(name, painter) for name in SHARED_FIGURES if name not in presented}
+                rep.figures = {**{k: p for k, p in shared.items() if p is not None}, **drawn}
+                for name, table in rep.tables.items():
+                    folder.write(f"{name}.csv", lambda p, t=table: t.to_csv(p, index=False))
+                painter.finish()
+    finally:
+        if painter is not None:  # (once the pool is shut down: no worker writes a figure any more)
+            painter.discard()
     rep.wall_time = time.perf_counter() - start
     paragraphs = [ctx.summary(dc="Dc" not in presented)] + [sc.summary(ctx, part) for sc, part in parts]
     rep.summary = summary(ctx, rep, paragraphs)

@@ -28,7 +28,7 @@ import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Iterator, Sequence
+from typing import Any, Callable, Iterable, Iterator, Sequence
 
 from tqdm.auto import tqdm
 
@@ -267,6 +267,23 @@ class Runner:
         finally:
             bar.close()
         return [records[k] for k in keys]
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Future:
+        """``fn(*args)`` on a worker of the local pool if it is running (``fn`` and ``args``
+        picklable), else at once in this process; a future either way.  For the work that
+        follows the micro tasks (a report's figures and its D_c fits): the pool's workers
+        are warm by then, and a pool is not started for it (spawning one costs seconds)."""
+        if self._pool is not None:
+            try:
+                return self._pool.submit(fn, *args)
+            except RuntimeError as exc:  # a broken pool (BrokenProcessPool): run it here
+                log.warning("the pool cannot take more work (%s); running it in this process", exc)
+        fut: Future = Future()
+        try:
+            fut.set_result(fn(*args))
+        except Exception as exc:  # noqa: BLE001 - handed to the caller through the future
+            fut.set_exception(exc)
+        return fut
 
     def _store(self, record: dict[str, Any]) -> None:
         task = record.get("task", {})

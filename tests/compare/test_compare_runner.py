@@ -3,7 +3,9 @@ bad input raises a ValueError that names the parameter."""
 from __future__ import annotations
 
 import json
+import os
 
+import pandas as pd
 import pytest
 
 import compare
@@ -96,9 +98,48 @@ def test_pool_result_equals_serial_result():
         serial = r.run(tasks)
     with Runner(compare.NullCache(), workers=2, progress=False) as r:
         pooled = r.run(tasks)
+        # the pool running, submit() hands work to its workers; without one, it runs here
+        assert r.submit(os.getpid).result() != os.getpid()
+    assert r.submit(os.getpid).result() == os.getpid()
+    with pytest.raises(ZeroDivisionError):
+        r.submit(divmod, 1, 0).result()
     for a, b in zip(serial, pooled):
         for name in ("regime", "sigma_max", "sigma_min", "sigma_mean", "t_end"):
             assert a["result"][name] == b["result"][name]
+
+
+def test_painter_draws_elsewhere_the_same_figure_and_leaves_no_temporary_file(tmp_path):
+    """A figure handed to a Painter is drawn by its submit (here a thread), returns its final
+    path at once, and lands in the folder byte for byte as drawn in place; a figure whose
+    job failed is drawn again in place; temporary files are gone either way."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from compare import figures
+    from compare.output import ReportFolder
+
+    t = {"fig10_eps": pd.DataFrame({"k0": [0.1, 0.1], "V": [1.0, 1.0], "eps": [0.02, 0.01],
+                                    "error": [2e-4, 1e-4], "converged": [True, False]})}
+    here = ReportFolder(tmp_path / "here")
+    figures.fig10(t, figures.target(here, "fig10.png"))
+    with ThreadPoolExecutor(1) as pool:
+        folder = ReportFolder(tmp_path / "there")
+        painter = figures.Painter(folder, pool.submit)
+        path = figures.fig10(t, figures.target(painter, "fig10.png"))
+        assert path == folder.path / "fig10.png"
+        painter.finish()
+    assert path.read_bytes() == (here.path / "fig10.png").read_bytes()
+    assert folder.files == ["fig10.png"]
+
+    def broken(fn, *args):
+        raise RuntimeError("worker died")
+
+    folder = ReportFolder(tmp_path / "broken")
+    painter = figures.Painter(folder, broken)
+    figures.fig10(t, figures.target(painter, "fig10.png"))
+    painter.finish()
+    assert (folder.path / "fig10.png").read_bytes() == (here.path / "fig10.png").read_bytes()
+    for f in (tmp_path / "there", tmp_path / "broken"):
+        assert sorted(p.name for p in f.iterdir() if p.suffix == ".png") == ["fig10.png"]
 
 
 @pytest.mark.parametrize("make,name", [
