@@ -67,7 +67,13 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--order", choices=("d", "N"), default="d",
                     help="outer loop over d (all N at one d first) or over N (all d at one N first)")
+    ap.add_argument("--trend", action="store_true",
+                    help="instead: fit the CSV's amplitudes at --k0 and each --d against N (see trend())")
     args = ap.parse_args()
+    if args.trend:
+        for d in (float(x) for x in args.d.split(",")):
+            trend(args.k0, d)
+        return
     model = micro.Model(k0=args.k0)
     vc = float(micro.critical_velocity(model).Vc)
     ds = [float(x) for x in args.d.split(",")]
@@ -113,6 +119,64 @@ def main() -> None:
                  "run_status", "shock_size_min", "largest_subthreshold", "cpu_s")
         print({k: row[k] for k in shown}, flush=True)
         write_csv(pd.DataFrame([row]), CSV, keys=KEYS)
+
+
+def trend(k0: float, d: float) -> None:
+    """The N-block's finite-N trend at (k0, d), from the CSV: for the amplitude, sigma_max
+    and sigma_min, the rows at one N (seeds, run lengths) pooled by inverse variance, then
+    value(N) = limit + c N^(-a) fitted by weighted least squares with a free and with
+    a = 1/2 and 1 fixed; each limit with its standard error and the fit's chi^2 per
+    degree of freedom.  Rows whose shocks are not
+    separated from the other avalanches are left out (and printed)."""
+    rows = pd.read_csv(CSV)
+    rows = rows[np.isclose(rows.k0, k0) & np.isclose(rows.d, d) & (rows.status == "ok")]
+    # a row is a check only where its shocks stand apart from the other avalanches: the
+    # smallest shock at least twice the threshold, the largest other avalanche below half of it
+    clean = (rows.shock_size_min >= 2.0 * rows.shock_fraction) & (rows.largest_subthreshold <= 0.5 * rows.shock_fraction)
+    for r in rows[~clean].itertuples():
+        print(f"k0 = {k0:g}, d = {d:g}, N = {r.N:.0f}, seed {r.seed}: left out, its shocks are not separated "
+              f"(smallest {r.shock_size_min:.3g} N, largest other avalanche {r.largest_subthreshold:.3g} N, "
+              f"threshold {r.shock_fraction:g} N); amplitude {r.amplitude:.6f} +- {r.amplitude_stderr:.1e}")
+    rows = rows[clean]
+    if rows.empty:
+        print(f"k0 = {k0:g}, d = {d:g}: no rows")
+        return
+    for col in ("amplitude", "sigma_max", "sigma_min"):
+        _trend_of(rows, col, k0, d)
+
+
+def _trend_of(rows: pd.DataFrame, col: str, k0: float, d: float) -> None:
+    from scipy.optimize import curve_fit
+
+    w = 1.0 / rows[f"{col}_stderr"] ** 2
+    by_n = (rows.assign(w=w, wa=w * rows[col]).groupby("N")
+            .agg(w=("w", "sum"), wa=("wa", "sum"), runs=("seed", "size"), cycles=("n_cycles", "sum")))
+    N = by_n.index.to_numpy(float)
+    val = (by_n.wa / by_n.w).to_numpy()
+    err = (1.0 / np.sqrt(by_n.w)).to_numpy()
+    print(f"k0 = {k0:g}, d = {d:g}: {col} by N (seeds and runs pooled)")
+    for n, a, e, r, c in zip(N, val, err, by_n.runs, by_n.cycles):
+        print(f"  N = {n:9.0f}: {a:.6f} +- {e:.1e}  ({r} runs, {c} shocks)")
+
+    def law(n, v_inf, c, a):
+        return v_inf + c * n ** (-a)
+
+    fits = []
+    if len(N) >= 4:
+        try:
+            p, cov = curve_fit(law, N, val, p0=(val[-1], (val[0] - val[-1]) * N[0] ** 0.5, 0.5), sigma=err,
+                               absolute_sigma=True, maxfev=20000)
+            fits.append(("a free", p, np.sqrt(np.diag(cov)), len(N) - 3))
+        except RuntimeError as exc:
+            print(f"  a free  : no fit ({exc})")
+    for a_fixed in (0.5, 1.0):
+        p, cov = curve_fit(lambda n, v_inf, c: law(n, v_inf, c, a_fixed), N, val, p0=(val[-1], 0.0), sigma=err,
+                           absolute_sigma=True)
+        fits.append((f"a = {a_fixed:g}", np.append(p, a_fixed), np.append(np.sqrt(np.diag(cov)), 0.0), len(N) - 2))
+    for name, p, e, dof in fits:
+        chi2 = float(np.sum(((law(N, *p) - val) / err) ** 2))
+        print(f"  {name:8s}: limit = {p[0]:.6f} +- {e[0]:.1e}, c = {p[1]:.3g}, a = {p[2]:.2f} +- {e[2]:.2f}; "
+              f"chi2/dof = {chi2:.2f}/{dof}")
 
 
 if __name__ == "__main__":
