@@ -32,6 +32,14 @@ grows a little faster than N, about 3.6 times per factor 3):
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --d 0.01 --N 100000,300000,1000000 --shock-fraction 0.05
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1,0.05,0.02 --N 100000,300000
         # k0 = 0.01: 2-3 times the cost at k0 = 0.1 (each block jumps 7-13 times in a total shock)
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1 --N 1000000 --seed 1
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1 --N 10000,30000 --n-cycles 1500
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1 --N 30000 --n-cycles 1500 --seed 1
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1 --N 100000 --n-cycles 800 --seed 3
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 1000000 --seed 1
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 30000,100000 --n-cycles 1000 --seed 2
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 300000 --n-cycles 600 --seed 2
+    python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1,0.05 --trend   # the finite-N fits
 """
 from __future__ import annotations
 

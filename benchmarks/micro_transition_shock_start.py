@@ -38,6 +38,13 @@ were bit-identical to a plain ``_one_cycle`` from a copy of the same state):
   so a fold of the step's closure (its slope 0) leaves the zero-time closure a slope
   b_artifact = k2 phi / (k1 + k2 - k2 phi) at 0; ``b_s_minus_artifact`` = b_s - 1 - b_artifact.
 
+The bulk of the way: H's largest slope (``slope_max``, at ``X_slope_max``: the excess
+branching ratio the closure reaches past its convex layer at 0) and its curvature over
+the middle half of [0, X_shock] (``bulk_curvature``, a line through H' there), against
+-k0 / lambda, the curvature of the contracted exponential at b = 1
+(docs/reference/micro_transition.md §2; ``bulk_curvature_over_k0_lam``), and the drop
+against 2 lambda ``slope_max``, the far root of that parabola (``drop_over_2lam_slope``).
+
 Also: the drop k0 X_shock against the prediction 2 lambda (b_s - 1) of a start at b_s > 1
 (lambda = kappa zbar), the fraction the shock leaves unjumped, the converged run's sigma_max,
 sigma_min and amplitude and the extra cycle's (``extra_*``), the loading phase's last full
@@ -160,6 +167,14 @@ class Probe(C._Cohorts):
         concave_share = float(widths[d2 < 0.0].sum() / widths.sum())
         infl = np.flatnonzero(np.sign(d2[1:]) != np.sign(d2[:-1]))
         first_inflection = float(Xi[infl[0] + 1]) if infl.size else math.nan
+        # the bulk: H's largest slope on the way (the excess branching ratio the closure
+        # reaches past the convex layer at 0) and its curvature over the middle half of the
+        # way (a least-squares line through H' on [X_shock / 4, 3 X_shock / 4])
+        ok = np.isfinite(dHi)
+        k = int(np.argmax(np.where(ok, dHi, -np.inf)))
+        slope_max, X_slope_max = float(dHi[k]), float(Xi[k])
+        mid = ok & (Xi >= 0.25 * slip) & (Xi <= 0.75 * slip)
+        bulk_curvature = float(np.polyfit(Xi[mid], dHi[mid], 1)[0]) if mid.sum() >= 3 else math.nan
         # interior extrema of H on (0, X_shock] from the sign of the analytic H'
         sgn = np.sign(dHi)
         mins = np.flatnonzero((sgn[:-1] < 0.0) & (sgn[1:] > 0.0))
@@ -186,7 +201,8 @@ class Probe(C._Cohorts):
                 b_pred = -math.sqrt(max(2.0 * H2_0 * c1 * max(delta_star, 0.0), 0.0))
         fold = self.step_fold(et)
         return dict(fold, H_at_0=H_at_0, b_s_minus_1=fd, b_s_minus_1_analytic=an, b_s_minus_1_10e=fd10, H2_0=H2_0,
-                    concave_share=concave_share, first_inflection=first_inflection, n_minima=int(mins.size),
+                    concave_share=concave_share, first_inflection=first_inflection, slope_max=slope_max,
+                    X_slope_max=X_slope_max, bulk_curvature=bulk_curvature, n_minima=int(mins.size),
                     n_maxima=int(maxs.size), X_min=Xm, H_min=Hm, X_max=Xp, H_max=Hp, sign_changes=n_changes,
                     grid_root=root, x0=x0, fold_c1=c1, fold_delta_over_et=delta_star / et, b_fold_pred=b_pred,
                     sigma_at_shock=self.sigma, t_at_shock=self.t, n_grid=int(X.size))
@@ -269,6 +285,8 @@ def measure(k0: float, d: float, dt: float, tol: float, max_iter: int) -> dict:
         slope, c0 = np.polyfit(u, np.array([s[4] for s in full]), 1)
     row.update(step=step, ok=out.get("ok"), X_shock=slip, drop=k0 * slip, pred_2lam_b=2.0 * lam * bs1,
                pred_over_drop=2.0 * lam * bs1 / (k0 * slip), unjumped=out.get("unjumped", math.nan),
+               bulk_curvature_over_k0_lam=info.get("bulk_curvature", math.nan) / (-k0 / lam),
+               drop_over_2lam_slope=k0 * slip / (2.0 * lam * info.get("slope_max", math.nan)),
                extra_sigma_max=out.get("sigma_max"), extra_sigma_min=out.get("sigma_min"),
                extra_sigma_before=out.get("sigma_before"), extra_sigma_after=out.get("sigma_after"),
                extra_period=out.get("period"), b_ss=bss, b_ss_minus_1=bss - 1.0,
@@ -287,7 +305,8 @@ def measure(k0: float, d: float, dt: float, tol: float, max_iter: int) -> dict:
 SHOW = [("k0", "{:g}"), ("d", "{:g}"), ("dt", "{:g}"), ("b_s_minus_1", "{:+.3e}"),
         ("b_s_minus_1_analytic", "{:+.3e}"), ("bs_over_bss", "{:+.2e}"), ("partial_step", "{:.3f}"),
         ("b_artifact", "{:+.3e}"), ("b_s_minus_artifact", "{:+.1e}"), ("H2_0", "{:+.3g}"),
-        ("concave_share", "{:.3f}"), ("n_minima", "{:d}"), ("step_fold_H_lo", "{:+.1e}"), ("step_fold_H_hi", "{:+.1e}"),
+        ("concave_share", "{:.3f}"), ("bulk_curvature_over_k0_lam", "{:.3f}"), ("drop_over_2lam_slope", "{:.3f}"),
+        ("n_minima", "{:d}"), ("step_fold_H_lo", "{:+.1e}"), ("step_fold_H_hi", "{:+.1e}"),
         ("X_shock", "{:.5g}"), ("drop", "{:.4e}"), ("pred_2lam_b", "{:+.3e}"), ("pred_over_drop", "{:+.2e}"),
         ("unjumped", "{:.3e}"), ("sigma_max", "{:.6f}"), ("sigma_min", "{:.6f}"), ("amplitude", "{:.6f}"),
         ("b_ss_minus_1", "{:+.3e}"), ("root_rel_diff", "{:.1e}"), ("cycle_wall_s", "{:.0f}")]

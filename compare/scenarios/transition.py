@@ -267,8 +267,9 @@ def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
                if r.method == "N-block" else f"the {r.method} at {_resolution(r, s)}")
         said.append(f"{_beta(r)} by {how} ({int(r.n_points)} points)")
     out.append("In micro the amplitude is set by the size of its shocks (each starts where the branching ratio "
-               "reaches 1, at a fold of the creep, and runs to a far root set by the whole pre-shock margin "
-               "distribution, not by an excess branching ratio), and it has no single power law: while "
+               "reaches 1, at a fold of the creep, and runs to a far root: a drop of about 2 kappa zbar times the "
+               "excess branching ratio of the margins beyond the layer the creep has emptied, not of those at the "
+               "threshold), and it has no single power law: while "
                "shocks are total it depends on k0 V alone and is about linear in d (derived up to a measured "
                "memory factor of 0.72-0.92), and shocks stop being total below a crossover at d of about k0/k2, "
                "whose law is not derived, though it becomes linear as d falls: at k0 = 0.1 the local exponent rises "
