@@ -116,7 +116,7 @@ class Settings:
         ``fig10_t_max``: each Fig. 10 run stops at this simulated time, settled or not (an
         unsettled one is drawn open, with its time mean over the run's later half): where
         the discretised density oscillates it never settles.  At t_max = 60 every point lies
-        within 3.6e-5 of runs of 480 time units, as at 120, in half the time
+        within 2.2e-5 of runs of 480 time units (2.4e-5 at 120), in half the time
         (docs/validation/micro_defaults.md, "Fig. 10").
     """
 
