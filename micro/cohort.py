@@ -134,6 +134,11 @@ STILL = 5.0
 #: The newborns of a step made their last jumps this fraction of it before its end, on
 #: average (they cross at a steady rate; the re-jumps are counted to the end).
 AGE = 0.5
+#: Aitken's extrapolation only where every ratio of successive steps is at most this: five
+#: cycles cannot tell a ratio closer to 1 from a drift, and a ratio a hair below 1 sends
+#: the extrapolation anywhere (a period of -0.43 from cycles at 0.2097, steps of 2.5e-8 a
+#: cycle); such a sequence is judged as one that does not contract.
+AITKEN_MAX_RATIO = 0.999
 #: Passed as ``start``: begin from the first shock's image, without a coarser run first.
 _NO_COARSE = object()
 
@@ -841,7 +846,7 @@ def _estimate(a: np.ndarray, tol: float, slowest: float = 0.0) -> tuple[np.ndarr
       the error;
     - a ratio is negative (the cycles alternate) and the last three steps are below
       ``tol / STILL``: noise, not a drift; the last cycle, ``F`` times the steps;
-    - all three ratios in [0, 1): a geometric tail; the last extrapolation, with twice
+    - all three ratios in [0, AITKEN_MAX_RATIO]: a geometric tail; the last extrapolation, with twice
       the spread of the three, plus the tail that the ratio's last rise, repeated once,
       would add (a slow mode taking over from a faster one raises the ratio), or if
       larger the tail a mode of multiplier ``slowest`` would add beyond the
@@ -870,11 +875,11 @@ def _estimate(a: np.ndarray, tol: float, slowest: float = 0.0) -> tuple[np.ndarr
         elif (r < 0.0).any() and steps[-3:].max() <= tol / STILL:
             errors[i] = still * steps[-3:].max()
             how.append("noise")
-        elif ((r >= 0.0) & (r < 1.0)).all():
+        elif ((r >= 0.0) & (r <= AITKEN_MAX_RATIO)).all():
             E = w[-3:, i] + di[-3:] * r / (1.0 - r)
             # a rising ratio (a slower mode taking over) goes on rising: its next step; and
             # a mode as slow as the model's slowest may not have shown itself yet
-            r_hi = max(min(r[-1] + max(r[-1] - r[0], 0.0), 0.999), min(slowest, 0.999))
+            r_hi = max(min(r[-1] + max(r[-1] - r[0], 0.0), AITKEN_MAX_RATIO), min(slowest, AITKEN_MAX_RATIO))
             tail = steps[-1] * (r_hi / (1.0 - r_hi) - r[-1] / (1.0 - r[-1]))
             errors[i], best[i] = tail + 2.0 * float(np.abs(E - E[-1]).max()), E[-1]
             how.append("Aitken")

@@ -383,6 +383,23 @@ def test_each_quantity_is_judged_on_its_own():
     assert rho[2] == pytest.approx(0.8, rel=1e-9)
 
 
+def test_an_extrapolation_that_runs_off_is_not_reported():
+    """A period drifting by 2.5e-8 a cycle with two nearly equal steps (ratio 1 - 4e-8, all
+    ratios in [0, 1)) sent Aitken's extrapolation to -0.43 from cycles at 0.2097, and the run
+    reported it (micro_cohort_other_choices.py, SHORT_PHASE = 1).  A ratio above 0.999 is
+    judged as a drift: the last cycle, with the error of a thousand such steps; a clean
+    geometric tail is still extrapolated."""
+    from micro.cohort import _estimate
+    d = np.array([-2.51e-8, -2.50e-8, -2.49e-8, -2.49e-8 * (1 - 4e-8)])
+    period = 0.2097144864 + np.concatenate([[0.0], np.cumsum(d)])
+    errors, how, best, _ = _estimate(period[:, None], 1e-6)
+    assert how == ["slow"] and best[0] == period[-1]
+    assert errors[0] == pytest.approx(1e3 * 2.50e-8, rel=1e-6)  # (the largest of the last three steps)
+    tail = 0.95 + 2e-4 * 0.8 ** np.arange(6)
+    errors, how, best, _ = _estimate(tail[:, None], 1e-6)
+    assert how == ["Aitken"] and best[0] == pytest.approx(0.95, abs=1e-13) and errors[0] < 1e-12
+
+
 def test_tiny_steps_along_a_slow_mode_are_not_convergence():
     """At k0 = 1e-3, d = 0.005 the cycles moved by 8e-8 a cycle (below tol / 100) and the
     rule called them converged to 4e-7; 300 more cycles drifted by 3.1e-5
