@@ -36,6 +36,7 @@ grows a little faster than N, about 3.6 times per factor 3):
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1 --N 10000,30000 --n-cycles 1500
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1 --N 30000 --n-cycles 1500 --seed 1
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1 --N 100000 --n-cycles 800 --seed 3
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1 --N 300000 --n-cycles 500 --seed 2
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 1000000 --seed 1
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 30000,100000 --n-cycles 1000 --seed 2
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 300000 --n-cycles 600 --seed 2
