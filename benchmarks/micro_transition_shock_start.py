@@ -59,6 +59,8 @@ the machine's other core):
 
     python benchmarks/micro_transition_shock_start.py --k0 0.1 --d 0.5 0.1 0.05 0.02 0.01   # 3.6 min
     python benchmarks/micro_transition_shock_start.py --k0 0.1 --d 0.005                    # 7.2 min
+    python benchmarks/micro_transition_shock_start.py --k0 0.3 0.1 --d 0.1 0.05 0.02 0.01   # 17 min (bulk columns)
+    python benchmarks/micro_transition_shock_start.py --k0 0.3 --d 0.005                    # 14 min
     python benchmarks/micro_transition_shock_start.py --k0 0.01 --d 0.5 0.1 0.05 0.02 0.01  # 3.9 min
     python benchmarks/micro_transition_shock_start.py --k0 0.01 --d 0.02 0.01 --tol 3e-5    # 3.5 min
     python benchmarks/micro_transition_shock_start.py --k0 0.1 0.01 --d 0.1 0.02 --dt 0.01  # 6.4 min
