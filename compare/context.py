@@ -353,8 +353,7 @@ class Context:
                     raise
                 except Exception as exc:  # noqa: BLE001 - the worker's failure, not the fit's: fit here
                     log.warning("D_c (a) at k0 = %g alone failed on a worker (%s); fitting it here", k0, exc)
-                    fit = fits.fit_dc(grp, self.law_for, bounds=self.s.dc_bounds, n_grid=self.s.dc_grid,
-                                      n_bootstrap=0)
+                    fit = self._fit_alone(grp, self.law_for)
             except ValueError as exc:  # (fewer than 3 usable points at this k0)
                 log.warning("D_c (a) at k0 = %g alone: %s", k0, exc)
                 continue
@@ -373,9 +372,13 @@ class Context:
         to every k0 (with the laws as a dict: this context does not travel)."""
         pts = self.micro_points
         laws = {float(k0): self.law_for(float(k0)) for k0 in pts.k0.unique()}
-        fit = partial(fits.fit_dc, bounds=self.s.dc_bounds, n_grid=self.s.dc_grid, n_bootstrap=0)
-        return [(float(k0), grp, self.runner.submit(fit, grp, laws.__getitem__))
+        return [(float(k0), grp, self.runner.submit(self._fit_alone, grp, laws.__getitem__))
                 for k0, grp in pts.groupby("k0", sort=False)]
+
+    @property
+    def _fit_alone(self) -> partial:
+        """The D_c (a) fit of one k0's points (``fit(points, law_for)``): no bootstrap."""
+        return partial(fits.fit_dc, bounds=self.s.dc_bounds, n_grid=self.s.dc_grid, n_bootstrap=0)
 
     @cached_property
     def dc_critical(self) -> fits.DcCriticalFit:
