@@ -37,10 +37,11 @@ parameter between levels is its discretisation uncertainty.
 Out of sample: each law fitted to the dt = 0.02 level at d >= 0.01 (k0 = 0.1) or 0.02
 (k0 = 0.3) and asked for that level's points below (at k0 = 0.1 the cold run at d = 0.005
 and the continuation's at 0.005 and 0.002, ``micro_cohort_above_vc.csv``).  And steady sliding's growth rate Lambda at each
-point (renewal chain): Lambda (b - 1) and Lambda T, T the cycle's period.
+point (renewal chain): Lambda (b - 1) against its derived asymptote and Lambda T, T the cycle's
+period; and the cycle's scaling with d (see ``growth_clock``).
 
-Writes ``micro_transition_points.csv``, ``micro_transition_fits.csv`` and
-``micro_transition_predictions.csv``.  Seconds.
+Writes ``micro_transition_points.csv``, ``micro_transition_fits.csv``,
+``micro_transition_predictions.csv`` and ``micro_transition_scaling.csv``.  Seconds.
 
     python benchmarks/micro_transition_fits.py
 """
@@ -269,19 +270,43 @@ def main() -> None:
     preds = [p for p in preds if len(p)]
     if preds:
         write_csv(pd.concat(preds, ignore_index=True), RESULTS / "micro_transition_predictions.csv")
-    growth_clock(pts)
+    write_csv(growth_clock(pts), RESULTS / "micro_transition_scaling.csv")
 
 
-def growth_clock(pts: pd.DataFrame) -> None:
-    """Steady sliding's growth rate Lambda against the cycle's loading time: Lambda (b - 1)
-    and Lambda T at the points' d (the renewal chain, milliseconds)."""
-    print("\nsteady sliding's growth rate against the cycle (renewal chain):")
+def growth_clock(pts: pd.DataFrame) -> pd.DataFrame:
+    """Steady sliding's growth rate Lambda against the cycle, and the cycle's scaling with d
+    (the renewal chain at each point's V, milliseconds; reference §2 and §4):
+
+    * ``lam_over_asymptote``: Lambda against its derived large-rate asymptote
+      k2 gamma b / ((k1 + k2)(b - 1)) - gamma;
+    * ``lam_T``: the loading time in e-folding times of the unstable mode;
+    * ``A_over_d``, ``T_over_d``, ``jumped_over_d`` (the fraction a shock moves),
+      ``above_over_d`` = (sigma_max - sigma_ss) / d and ``below_over_d`` =
+      (sigma_ss - sigma_min) / d, sigma_ss steady sliding's stress at the same V: all
+      constant where the partial-shock cycle scales with d;
+    * ``beta_local``, ``S_mid``: the local exponent between a point and the next larger d,
+      against the geometric mean of their S = (k1 + k2) A / (k0 kappa zbar)."""
+    rows = []
     for k0, grp in pts.groupby("k0", sort=False):
-        g = grp.sort_values("d", ascending=False)
-        st = micro.steady_sliding(micro.Model(k0=k0), list(g.V))
-        for d, b, lam, T in zip(g.d, st.branching_ratio, st.growth_rate, g.period):
-            print(f"k0 = {k0:g}, d = {d:g}: b - 1 = {b - 1:.4g} ({(b - 1) / d:.4g} d), Lambda = {lam:.4g}, "
-                  f"Lambda (b - 1) = {lam * (b - 1):.3f}, Lambda T = {lam * T:.3g}")
+        g = grp.sort_values("d")
+        model = micro.Model(k0=k0)
+        gamma = model.k2 / model.eta_u
+        st = micro.steady_sliding(model, list(g.V))
+        b, lam, sig = (np.asarray(x, float) for x in (st.branching_ratio, st.growth_rate, st.sigma))
+        asym = model.k2 * gamma * b / ((model.k1 + model.k2) * (b - 1.0)) - gamma
+        d, A = g.d.to_numpy(), g.amplitude.to_numpy()
+        beta = np.append(np.log(A[1:] / A[:-1]) / np.log(d[1:] / d[:-1]), np.nan)
+        S_mid = np.append(np.sqrt(g.S.to_numpy()[1:] * g.S.to_numpy()[:-1]), np.nan)
+        rows.append(pd.DataFrame(dict(
+            k0=k0, d=d, S=g.S.to_numpy(), b_minus_1=b - 1.0, lam=lam, lam_over_asymptote=lam / asym,
+            lam_T=lam * g.period.to_numpy(), A_over_d=A / d, T_over_d=g.period.to_numpy() / d,
+            jumped_over_d=(1.0 - g.unjumped.to_numpy()) / d,
+            above_over_d=(g.sigma_max.to_numpy() - sig) / d, below_over_d=(sig - g.sigma_min.to_numpy()) / d,
+            beta_local=beta, S_mid=S_mid)))
+    out = pd.concat(rows, ignore_index=True)
+    print("\nsteady sliding's growth rate against the cycle, and the cycle's scaling with d (renewal chain):")
+    print(out.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    return out
 
 
 def predictions(raw: pd.DataFrame, k0: float = 0.1, dt: float = 0.02, d_fit: float = 0.01) -> pd.DataFrame:

@@ -143,7 +143,8 @@ def test_transition_verdict_is_one_paragraph_on_both_sides(rep):
     cohort = rep["hopf_fit"].set_index("method").loc["cohort"]
     for part in ("same singular way", "c0 d^(1/2) (1 + c2 d)", f"c0 = {law['c0']:.4g}",
                  f"beta = {cohort.beta:.2f} (95 % CI {cohort.beta_low:.2f} to {cohort.beta_high:.2f})",
-                 "it has no single power law", "crossover at d of about k0/k2", "checked against the Richardson limit",
+                 "It has no single power law", "crossover at d of about k0/k2",
+                 "time scale is itself proportional to d", "checked against the Richardson limit",
                  "down to d = 0.02"):
         assert part in text, part
 

@@ -186,6 +186,23 @@ def test_growth_rate_diverges_at_the_critical_velocity():
     assert np.all(np.diff(rates) > 0) and rates[-1] > 10 * rates[0]
 
 
+@pytest.mark.parametrize("params", [dict(k0=0.3), dict(k0=0.1), dict(k0=0.1, k1=0.3, k2=0.5, eta_u=2.0)])
+def test_growth_rate_near_the_critical_velocity_follows_its_derived_asymptote(params):
+    # docs/reference/micro_transition.md §2: a fast perturbation of the slip shifts every
+    # margin by -(k1 + k2) Y at once and the dashpots give back k2 Y at rate gamma, so at
+    # large rate 1 = b - zbar p(0) k2 gamma / (Lambda + gamma), i.e.
+    # Lambda = k2 gamma b / ((k1 + k2)(b - 1)) - gamma + O(1): the renewal chain's root of
+    # G(Lambda) = 1 must approach it, its relative gap falling like d (0.3 d to 0.7 d here)
+    model = micro.Model(**params)
+    Vc = micro.critical_velocity(model).Vc
+    gamma = model.k2 / model.eta_u
+    res = micro.steady_sliding(model, [0.99 * Vc, 0.999 * Vc])
+    b, lam = np.asarray(res.branching_ratio), np.asarray(res.growth_rate)
+    asymptote = model.k2 * gamma * b / ((model.k1 + model.k2) * (b - 1)) - gamma
+    gap = np.abs(lam / asymptote - 1)
+    assert gap[1] < 1.5e-3 and gap[1] < gap[0] / 4
+
+
 def test_critical_velocity_inside_the_fokker_planck_and_n_block_brackets():
     # independent brackets (docs/reference/micro_numerics.md §5, docs/validation/micro_results.md): FP bisection with
     # the check at eps/2 and N-block amplitudes: k0 = 0.3: 0.19-0.21 (FP 0.186-0.191),
