@@ -41,7 +41,8 @@ point (renewal chain): Lambda (b - 1) against its derived asymptote and Lambda T
 period; and the cycle's scaling with d (see ``growth_clock``).
 
 Writes ``micro_transition_points.csv``, ``micro_transition_fits.csv``,
-``micro_transition_predictions.csv`` and ``micro_transition_scaling.csv``.  Seconds.
+``micro_transition_predictions.csv`` and ``micro_transition_scaling.csv``, and the figure
+``micro_transition_scaling.png`` (A / d against d, the local exponent against S).  Seconds.
 
     python benchmarks/micro_transition_fits.py
 """
@@ -53,7 +54,7 @@ from scipy import optimize, stats
 
 import micro
 
-from _harness import RESULTS, write_csv
+from _harness import RESULTS, pyplot, save_figure, write_csv
 
 FLOOR = 5e-5
 
@@ -270,7 +271,9 @@ def main() -> None:
     preds = [p for p in preds if len(p)]
     if preds:
         write_csv(pd.concat(preds, ignore_index=True), RESULTS / "micro_transition_predictions.csv")
-    write_csv(growth_clock(pts), RESULTS / "micro_transition_scaling.csv")
+    scaling = growth_clock(pts)
+    write_csv(scaling, RESULTS / "micro_transition_scaling.csv")
+    plot_scaling(scaling, pts)
 
 
 def growth_clock(pts: pd.DataFrame) -> pd.DataFrame:
@@ -307,6 +310,37 @@ def growth_clock(pts: pd.DataFrame) -> pd.DataFrame:
     print("\nsteady sliding's growth rate against the cycle, and the cycle's scaling with d (renewal chain):")
     print(out.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     return out
+
+
+def plot_scaling(sc: pd.DataFrame, pts: pd.DataFrame) -> None:
+    """``micro_transition_scaling.png``: A/d against d (constant where the partial-shock cycle
+    scales with d, reference §4.1) and the local exponent against S, per k0."""
+    plt = pyplot()
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.4))
+    near = pts[pts.d <= 0.1]
+    for i, (k0, g) in enumerate(near.groupby("k0", sort=False)):
+        c, g = f"C{i}", g.sort_values("d")
+        bars = g.amp_err.notna()
+        ax.errorbar(g.d[bars], g.amplitude[bars] / g.d[bars], yerr=g.amp_err[bars] / g.d[bars], fmt="o-", color=c,
+                    ms=4, capsize=2, label=f"k0 = {k0:g}")
+        ax.plot(g.d[~bars], g.amplitude[~bars] / g.d[~bars], "o", mfc="none", color=c, ms=5)
+        s = sc[(sc.k0 == k0) & (sc.d < 0.1)].dropna(subset=["beta_local"]).sort_values("S_mid")  # pairs within d <= 0.1
+        ax2.plot(s.S_mid, s.beta_local, "o-", color=c, label=f"k0 = {k0:g}")
+    ax.plot([], [], "o", mfc="none", color="k", label="one level (no bar)")
+    ax2.axhline(1.0, color="0.6", lw=0.8, ls="--")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax2.set_xscale("log")
+    ax.set_xlabel("d = (V^c - V) / V^c")
+    ax.set_ylabel("A / d")
+    ax2.set_xlabel("S = (k1 + k2) A / (k0 kappa zbar), geometric mean of neighbours")
+    ax2.set_ylabel("local exponent d ln A / d ln d")
+    ax.set_title("A / d: constant once the cycle scales with d (k0 = 0.3, d <= 0.02)", fontsize=9)
+    ax2.set_title("the local exponent against a shock's reach S", fontsize=9)
+    ax.legend(fontsize=7)
+    ax2.legend(fontsize=7)
+    fig.tight_layout()
+    save_figure(fig, RESULTS / "micro_transition_scaling.png")
 
 
 def predictions(raw: pd.DataFrame, k0: float = 0.1, dt: float = 0.02, d_fit: float = 0.01) -> pd.DataFrame:
