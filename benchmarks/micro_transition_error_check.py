@@ -83,8 +83,9 @@ def plot() -> None:
     nb = pd.read_csv(NBLOCK_CSV) if NBLOCK_CSV.exists() else pd.DataFrame()
     plt = pyplot()
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.4))
-    for i, (k0, g) in enumerate(f.groupby("k0")):
-        c = f"C{i}"
+    colour = {k0: f"C{i}" for i, k0 in enumerate(sorted(f.k0.unique()))}
+    for k0, g in f.groupby("k0"):
+        c = colour[k0]
         row = g[g.level == 0].sort_values("d")
         ok = row.certified.astype(bool)
         ax.errorbar(row.d[ok], row.amplitude[ok], yerr=2 * row.bound[ok], fmt="o", color=c, ms=4, capsize=2,
@@ -95,10 +96,17 @@ def plot() -> None:
         ax2.plot(lim.d, lim.bound / lim.amplitude, "o-", color=c, label=f"k0 = {k0:g}: bound / A")
         ax2.plot(lim.d, np.maximum(lim.true_sigma_max, lim.true_sigma_min) / lim.amplitude, "x--", color=c,
                  label=f"k0 = {k0:g}: true error / A")
-    for j, (N, g) in enumerate(nb.groupby("N") if len(nb) else []):
-        g = g.sort_values("d")
-        ax.errorbar(g.d, g.amplitude, yerr=g.amplitude_stderr, fmt="s", mfc="none", ms=3 + j, color="0.4",
-                    alpha=0.5 + 0.5 * j / max(1, nb.N.nunique() - 1), label=f"N-block k0 = 0.1, N = {N:.0e}")
+    nb = nb[nb.k0.isin(list(colour))] if len(nb) else nb
+    sizes = {N: 3 + j for j, N in enumerate(sorted(nb.N.unique()))} if len(nb) else {}
+    for (k0, N), g in (nb.groupby(["k0", "N"]) if len(nb) else []):
+        # each (k0, N): the seeds pooled by inverse variance; squares grow with N
+        w = 1.0 / g.amplitude_stderr ** 2
+        pooled = (g.assign(w=w, wa=w * g.amplitude).groupby("d")[["w", "wa"]].sum())
+        ax.errorbar(pooled.index, pooled.wa / pooled.w, yerr=1.0 / np.sqrt(pooled.w), fmt="s", mfc="none",
+                    ms=sizes[N], color=colour[k0], alpha=0.6, lw=0.8)
+    if len(nb):
+        ax.plot([], [], "s", mfc="none", color="k", label="N-block (seeds pooled), larger squares: larger N "
+                f"({', '.join(f'{N:.0e}' for N in sizes)})")
     ax.plot([], [], "x", color="k", label="Richardson limit of two finer levels")
     ax.plot([], [], "o", mfc="none", color="k", label="fixed point not certified")
     for a in (ax, ax2):
@@ -107,7 +115,8 @@ def plot() -> None:
         a.set_xlabel("d = (V^c - V) / V^c")
     ax.set_ylabel("amplitude sigma_max - sigma_min")
     ax2.set_ylabel("error / amplitude")
-    ax.legend(fontsize=6.5, loc="lower right")
+    ax.set_ylim(top=0.2)  # room for the legend above the points
+    ax.legend(fontsize=6.5, loc="upper left")
     ax2.legend(fontsize=6.5)
     ax.set_title("the cohort method near V^c, checked (default rows, finer levels, N-block)", fontsize=9)
     ax2.set_title("the default row's bound against its true error", fontsize=9)
