@@ -294,13 +294,17 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     (filled: the error is known and the point is fitted; open: not known, not fitted),
     each method's fitted law over the d it rests on with its interval, and RS's derived
     asymptote c0 d^(1/2) (1 + c2 d) (``values['rs_amplitude_law']``); micro has none
-    derived, and the figure says so."""
+    derived, and the figure says so.  On the left, micro's derived growth-rate asymptote
+    (``micro_spectrum.growth_rate_asymptote``, :func:`micro.growth_rate_near_vc`)."""
     pts, fit, spec = t["hopf_points"], t["hopf_fit"], t["micro_spectrum"]
     k0 = float(pts.k0.iloc[0]) if len(pts) else math.nan
     fig, axes = plt.subplots(1, 2, figsize=(13.5, 5.4), gridspec_kw={"width_ratios": [1, 1.45]})
     ax = axes[0]
     sp = spec[np.isfinite(spec.growth_rate) & (spec.growth_rate > 0)]
     ax.loglog(sp.d, sp.growth_rate, "o-", ms=3, color="C1", label="micro: real mode (branching ratio -> 1 at V^c)")
+    if "growth_rate_asymptote" in sp:
+        ax.loglog(sp.d, sp.growth_rate_asymptote, "--", color="C1", lw=0.9,
+                  label="micro, derived: k2 gamma b / ((k1 + k2)(b - 1)) - gamma")
     rs_sp = t.get("rs_spectrum")
     if rs_sp is not None and len(rs_sp):
         r = rs_sp[np.isfinite(rs_sp.growth_rate) & (rs_sp.growth_rate > 0)]

@@ -28,7 +28,8 @@ from .grid import GridTooLarge
 from .analytic import sigma_deterministic_steady, sigma_fast_limit, sigma_slow_limit
 from .params import Deterministic, Exponential, JumpDistribution, Model, Tabulated
 from .protocols import Drive
-from .renewal import SteadySliding, characteristic_function, steady_sliding, unstable_mode_count, vc_small_k0
+from .renewal import (SteadySliding, characteristic_function, growth_rate_near_vc, steady_sliding,
+                      unstable_mode_count, vc_small_k0)
 from .methods import FP, Auto, Cohort, Convergence, Numerics, Renewal, default_eps
 from .results import Critical, CycleFixedPoint, Run, Stationary
 from .api import critical_velocity, simulate, slide_hold_slide, stationary, sweep
@@ -53,6 +54,7 @@ __all__ = [
     "SteadySliding",
     "steady_sliding",
     "characteristic_function",
+    "growth_rate_near_vc",
     "unstable_mode_count",
     "vc_small_k0",
     "GridTooLarge",

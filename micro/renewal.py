@@ -57,7 +57,7 @@ from .analytic import _check_model
 from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
 
 __all__ = ["SteadySliding", "steady_sliding", "critical_velocity_renewal", "characteristic_function",
-           "unstable_mode_count", "vc_small_k0"]
+           "growth_rate_near_vc", "unstable_mode_count", "vc_small_k0"]
 
 log = logging.getLogger(__name__)
 
@@ -464,6 +464,30 @@ def _growth_rate(model: Model, V: float, b: float, tol: float) -> float:
             return math.nan
         hi, f_hi = lo, f_lo
     return model.gamma * math.exp(brentq(f, lo, hi, xtol=1e-12))
+
+
+def growth_rate_near_vc(model: Model, b):
+    r"""The growth rate of steady sliding's unstable mode close to V^c, from its branching
+    ratio ``b`` > 1: :math:`\Lambda = \frac{k_2\gamma}{k_1 + k_2}\frac{b}{b - 1} - \gamma` (per unit
+    time).
+
+    The asymptote of the root of G(Lambda) = 1 as b -> 1+ (docs/reference/micro_transition.md
+    §4.1): a fast slip perturbation Y shifts every margin by -(k1 + k2) Y at once, the dashpots
+    give back k2 Y at the rate gamma, and the mode lives while that relief lags the excess
+    b - 1.  Its relative error is about d = 1 - V/V^c (0.3 d to d at the paper's parameters);
+    NaN where b <= 1.
+
+    >>> import micro
+    >>> m = micro.Model(k0=0.1)
+    >>> st = micro.steady_sliding(m, 0.999 * micro.critical_velocity(m).Vc)
+    >>> bool(abs(micro.growth_rate_near_vc(m, st.branching_ratio) / st.growth_rate - 1) < 1e-3)
+    True
+    """
+    b = np.asarray(b, dtype=float)
+    gamma = model.k2 / model.eta_u
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = model.k2 * gamma * b / ((model.k1 + model.k2) * (b - 1.0)) - gamma
+    return np.where(b > 1.0, lam, np.nan)[()]
 
 
 @blas_single_threaded

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+import micro
 import rsf
 from micro.api import NEAR_VC
 
@@ -160,7 +161,8 @@ def run(ctx: Context) -> Part:
     b = ctx.branch
     spec = b[(b.role == "branch") & np.isclose(b.k0, k0) & (b.V < vc)].sort_values("V")
     part.tables["micro_spectrum"] = spec[["k0", "V", "Vc", "branching_ratio", "stable", "growth_rate"]].assign(
-        d=1.0 - spec.V / vc)
+        d=1.0 - spec.V / vc,
+        growth_rate_asymptote=micro.growth_rate_near_vc(ctx.model(k0), spec.branching_ratio.to_numpy(float)))
     part.values["transition"] = fits.classify_transition(part.tables["micro_spectrum"], part.tables["hopf_fit"],
                                                          points)
     part.values["transition_verdict"] = verdict(s, part.tables, part.values)

@@ -100,6 +100,11 @@ def test_transition_evidence(rep):
     # the N-block amplitude vanishes like a square root (0.5-0.6 in docs; a frozen solver gives 0)
     assert 0.35 < tr["beta"] < 0.8
     assert "not a Hopf bifurcation" in rep.summary
+    # the spectrum's derived asymptote (micro.growth_rate_near_vc) closes in on the renewal
+    # chain's growth rate towards V^c, its relative gap about d (0.67 d at k0 = 0.1)
+    sp = rep["micro_spectrum"].dropna(subset=["growth_rate"]).sort_values("d")
+    gap = (sp.growth_rate / sp.growth_rate_asymptote - 1).abs().to_numpy()
+    assert gap[0] < 1.2 * sp.d.iloc[0] and gap[0] < gap[-1]
 
 
 def test_transition_table_one_row_per_method_with_interval_and_range(rep):

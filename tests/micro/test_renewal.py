@@ -195,12 +195,11 @@ def test_growth_rate_near_the_critical_velocity_follows_its_derived_asymptote(pa
     # G(Lambda) = 1 must approach it, its relative gap falling like d (0.3 d to 0.7 d here)
     model = micro.Model(**params)
     Vc = micro.critical_velocity(model).Vc
-    gamma = model.k2 / model.eta_u
-    res = micro.steady_sliding(model, [0.99 * Vc, 0.999 * Vc])
-    b, lam = np.asarray(res.branching_ratio), np.asarray(res.growth_rate)
-    asymptote = model.k2 * gamma * b / ((model.k1 + model.k2) * (b - 1)) - gamma
-    gap = np.abs(lam / asymptote - 1)
+    res = micro.steady_sliding(model, [0.99 * Vc, 0.999 * Vc, 1.001 * Vc])
+    asymptote = micro.growth_rate_near_vc(model, res.branching_ratio)
+    gap = np.abs(np.asarray(res.growth_rate)[:2] / asymptote[:2] - 1)
     assert gap[1] < 1.5e-3 and gap[1] < gap[0] / 4
+    assert math.isnan(asymptote[2])  # stable: no unstable mode
 
 
 def test_critical_velocity_inside_the_fokker_planck_and_n_block_brackets():
