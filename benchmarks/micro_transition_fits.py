@@ -293,10 +293,9 @@ def growth_clock(pts: pd.DataFrame) -> pd.DataFrame:
     for k0, grp in pts.groupby("k0", sort=False):
         g = grp.sort_values("d")
         model = micro.Model(k0=k0)
-        gamma = model.k2 / model.eta_u
         st = micro.steady_sliding(model, list(g.V))
         b, lam, sig = (np.asarray(x, float) for x in (st.branching_ratio, st.growth_rate, st.sigma))
-        asym = model.k2 * gamma * b / ((model.k1 + model.k2) * (b - 1.0)) - gamma
+        asym = micro.growth_rate_near_vc(model, b)
         d, A = g.d.to_numpy(), g.amplitude.to_numpy()
         beta = np.append(np.log(A[1:] / A[:-1]) / np.log(d[1:] / d[:-1]), np.nan)
         S_mid = np.append(np.sqrt(g.S.to_numpy()[1:] * g.S.to_numpy()[:-1]), np.nan)
