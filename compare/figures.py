@@ -293,8 +293,8 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     against d, log-log, each against its own exact V^c: the points with their error bars
     (filled: the error is known and the point is fitted; open: not known, not fitted),
     each method's fitted law over the d it rests on with its interval, and RS's derived
-    asymptote c0 d^(1/2) (1 + c2 d) (``values['rs_amplitude_law']``); micro has none
-    derived, and the figure says so.  On the left, micro's derived growth-rate asymptote
+    asymptote c0 d^(1/2) (1 + c2 d) (``values['rs_amplitude_law']``); micro's amplitude has
+    no derived prefactor, and the figure says so.  On the left, micro's derived growth-rate asymptote
     (``micro_spectrum.growth_rate_asymptote``, :func:`micro.growth_rate_near_vc`)."""
     pts, fit, spec = t["hopf_points"], t["hopf_fit"], t["micro_spectrum"]
     k0 = float(pts.k0.iloc[0]) if len(pts) else math.nan
@@ -369,12 +369,13 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     if lo < NEAR_VC:
         keep(ax.axvspan(lo, min(NEAR_VC, hi), color="0.5", alpha=0.1, lw=0),
              f"d < {NEAR_VC:g}: micro's law not settled (the cohort's error not known)")
-    ax.text(0.02, 0.97, "micro: no single power law; crossover at d ~ k0/k2", transform=ax.transAxes, ha="left", va="top",
+    ax.text(0.02, 0.97, "micro: no single power law; crossover at d ~ k0/k2,\nlinear in d again deep below it "
+            "(scaling argument, prefactor not derived)", transform=ax.transAxes, ha="left", va="top",
             fontsize=8, color="C1")
     ax.set_xlabel("d = (V^c - V) / V^c (each model's own exact V^c)")
     ax.set_ylabel("sigma_max - sigma_min")
     ax.set_title("Amplitude near V^c: points with their errors, fitted laws [95 % CI] over the d they rest on,\n"
-                 "RS's derived asymptote (micro: none derived)", fontsize=9)
+                 "RS's derived asymptote (micro: no prefactor derived)", fontsize=9)
     ax.legend([hd for hd, _ in handles], [lb for _, lb in handles], fontsize=6, loc="lower right")
     return _save(fig, path)
 
