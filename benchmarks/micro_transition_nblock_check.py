@@ -9,7 +9,12 @@ avalanche of at least ``--shock-fraction`` * N jumps: close to V^c a shock leave
 blocks unjumped (about 61 % at k0 = 0.1, d = 0.01 by the cohort method), so the default
 0.15 is below the function's 0.25.  Each row records the means and standard errors
 (lag-1 corrected) of sigma_max and sigma_min, the amplitude sigma_max - sigma_min with
-the hypot of the two errors, the period, the function's status ('transient' if the
+the hypot of the two errors.  (The N-block's sigma_max and sigma_min are the stress just
+before and just after its shocks, the paper's sigma_B and sigma_A: compare them with the
+cohort's ``sigma_before`` and ``sigma_after``.  Those equal the cohort's cycle extremes
+exactly at k0 <= 0.01 and to 1e-5 at k0 = 0.1, d <= 0.1 (2e-5 at d = 0.2), but at
+k0 = 0.3 the creep before a shock outruns the drive and the stress peaks 2-3e-4 above
+sigma_B at d = 0.05-0.1.)  Also the period, the function's status ('transient' if the
 cycles still drift, 'fewer_cycles' if t_max cut the run short) and the run's own status
 ('shock_limit' when it stopped at the requested shock count, i.e. t_max was not
 reached), and the checks that the shocks are global: the smallest and mean shock size
