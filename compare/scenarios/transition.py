@@ -278,8 +278,8 @@ def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
                "prefactor not derived.")
     out.append("There the unstable mode's time scale is itself proportional to d (derived), and the amplitude, "
                "the loading time and the pre-shock distance from steady sliding all scale with d: constant to 5 % "
-               "at k0 = 0.3, d = 0.005-0.02 (A ≈ 0.25 d), approached at k0 = 0.1, whose local exponent rises from "
-               "0.59 at the crossover to 0.88 at d = 0.002-0.005 (docs/reference/micro_transition.md, "
+               "at k0 = 0.3, d = 0.005-0.02 (A ≈ 0.25 d), and at k0 = 0.1 the local exponent rises from 0.59 at "
+               "the crossover to 0.95 at d = 0.001-0.002 (A ≈ 0.63 d) (docs/reference/micro_transition.md, "
                "docs/validation/micro_transition.md).")
     out.append("Fitted: " + "; ".join(said) + "." if said else "No amplitude law could be fitted.")
     if micro_div and rs_div:
