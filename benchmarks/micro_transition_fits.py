@@ -352,7 +352,7 @@ def plot_scaling(sc: pd.DataFrame, pts: pd.DataFrame) -> None:
     ax.set_ylabel("A / d")
     ax2.set_xlabel("S = (k1 + k2) A / (k0 kappa zbar), geometric mean of neighbours")
     ax2.set_ylabel("local exponent d ln A / d ln d")
-    ax.set_title("A / d: constant once the cycle scales with d (k0 = 0.3, d <= 0.02)", fontsize=9)
+    ax.set_title("A / d: flat where the cycle scales with d (k0 = 0.3 below d = 0.02, 0.1 below 0.002)", fontsize=9)
     ax2.set_title("the local exponent against a shock's reach S", fontsize=9)
     ax.legend(fontsize=7)
     ax2.legend(fontsize=7)
