@@ -484,9 +484,8 @@ def growth_rate_near_vc(model: Model, b):
     True
     """
     b = np.asarray(b, dtype=float)
-    gamma = model.k2 / model.eta_u
     with np.errstate(divide="ignore", invalid="ignore"):
-        lam = model.k2 * gamma * b / ((model.k1 + model.k2) * (b - 1.0)) - gamma
+        lam = model.k2 * model.gamma * b / ((model.k1 + model.k2) * (b - 1.0)) - model.gamma
     return np.where(b > 1.0, lam, np.nan)[()]
 
 

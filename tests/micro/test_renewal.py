@@ -188,7 +188,7 @@ def test_growth_rate_diverges_at_the_critical_velocity():
 
 @pytest.mark.parametrize("params", [dict(k0=0.3), dict(k0=0.1), dict(k0=0.1, k1=0.3, k2=0.5, eta_u=2.0)])
 def test_growth_rate_near_the_critical_velocity_follows_its_derived_asymptote(params):
-    # docs/reference/micro_transition.md §2: a fast perturbation of the slip shifts every
+    # docs/reference/micro_transition.md §4.1: a fast perturbation of the slip shifts every
     # margin by -(k1 + k2) Y at once and the dashpots give back k2 Y at rate gamma, so at
     # large rate 1 = b - zbar p(0) k2 gamma / (Lambda + gamma), i.e.
     # Lambda = k2 gamma b / ((k1 + k2)(b - 1)) - gamma + O(1): the renewal chain's root of
