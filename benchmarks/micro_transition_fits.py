@@ -34,9 +34,11 @@ it where k0 = 1e-3 covers its d_r (``A_over_F_ref``), both at the default level 
 alone, unweighted (its discretisation error moves its points together): the change of a
 parameter between levels is its discretisation uncertainty.
 
-Out of sample: each law fitted to the dt = 0.02 level at d >= 0.01 (k0 = 0.1) or 0.02
-(k0 = 0.3) and asked for that level's points below (at k0 = 0.1 the cold run at d = 0.005
-and the continuation's at 0.005 and 0.002, ``micro_cohort_above_vc.csv``).  And steady sliding's growth rate Lambda at each
+Out of sample: each law fitted to one level at d >= 0.01 (k0 = 0.1, dt = 0.02 and 0.01) or
+0.02 (k0 = 0.3, dt = 0.02) and asked for that level's points below (at k0 = 0.1 the cold
+run at d = 0.005 and the continuation's at 0.005, 0.002 and 0.001,
+``micro_cohort_above_vc.csv``; the continuation's points where no cold run exists also
+enter the points table, the scaling table and the figure, not the fits).  And steady sliding's growth rate Lambda at each
 point (renewal chain): Lambda (b - 1) against its derived asymptote and Lambda T, T the cycle's
 period; and the cycle's scaling with d (see ``growth_clock``).
 
@@ -296,7 +298,7 @@ def main() -> None:
 
 def growth_clock(pts: pd.DataFrame) -> pd.DataFrame:
     """Steady sliding's growth rate Lambda against the cycle, and the cycle's scaling with d
-    (the renewal chain at each point's V, milliseconds; reference §2 and §4):
+    (the renewal chain at each point's V, milliseconds; reference §4.1):
 
     * ``lam_over_asymptote``: Lambda against its derived large-rate asymptote
       k2 gamma b / ((k1 + k2)(b - 1)) - gamma;
