@@ -36,6 +36,7 @@ import micro
 from micro.cohort import cycle_cohorts
 
 from _harness import RESULTS, Stopwatch, pyplot, save_figure, warm_up, write_csv
+from micro_transition_nblock_check import separated
 
 CSV = RESULTS / "micro_transition_error_check.csv"
 NBLOCK_CSV = RESULTS / "micro_transition_nblock_check.csv"
@@ -96,7 +97,7 @@ def plot() -> None:
         ax2.plot(lim.d, lim.bound / lim.amplitude, "o-", color=c, label=f"k0 = {k0:g}: bound / A")
         ax2.plot(lim.d, np.maximum(lim.true_sigma_max, lim.true_sigma_min) / lim.amplitude, "x--", color=c,
                  label=f"k0 = {k0:g}: true error / A")
-    nb = nb[nb.k0.isin(list(colour))] if len(nb) else nb
+    nb = nb[nb.k0.isin(list(colour)) & separated(nb) & (nb.status == "ok")] if len(nb) else nb
     sizes = {N: 3 + j for j, N in enumerate(sorted(nb.N.unique()))} if len(nb) else {}
     for (k0, N), g in (nb.groupby(["k0", "N"]) if len(nb) else []):
         # each (k0, N): the seeds pooled by inverse variance; squares grow with N
@@ -105,7 +106,7 @@ def plot() -> None:
         ax.errorbar(pooled.index, pooled.wa / pooled.w, yerr=1.0 / np.sqrt(pooled.w), fmt="s", mfc="none",
                     ms=sizes[N], color=colour[k0], alpha=0.6, lw=0.8)
     if len(nb):
-        ax.plot([], [], "s", mfc="none", color="k", label="N-block (seeds pooled), larger squares: larger N "
+        ax.plot([], [], "s", mfc="none", color="k", label="N-block (seeds pooled; shocks separated), larger: larger N "
                 f"({', '.join(f'{N:.0e}' for N in sizes)})")
     ax.plot([], [], "x", color="k", label="Richardson limit of two finer levels")
     ax.plot([], [], "o", mfc="none", color="k", label="fixed point not certified")

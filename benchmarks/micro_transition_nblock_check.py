@@ -135,6 +135,12 @@ def main() -> None:
         write_csv(pd.DataFrame([row]), CSV, keys=KEYS)
 
 
+def separated(rows: pd.DataFrame) -> pd.Series:
+    """Whether each row is a check: its shocks stand apart from the other avalanches (the
+    smallest shock at least twice the threshold, the largest other avalanche below half of it)."""
+    return (rows.shock_size_min >= 2.0 * rows.shock_fraction) & (rows.largest_subthreshold <= 0.5 * rows.shock_fraction)
+
+
 def trend(k0: float, d: float) -> None:
     """The N-block's finite-N trend at (k0, d), from the CSV: for the amplitude, sigma_max
     and sigma_min, the rows at one N (seeds, run lengths) pooled by inverse variance, then
@@ -144,9 +150,7 @@ def trend(k0: float, d: float) -> None:
     separated from the other avalanches are left out (and printed)."""
     rows = pd.read_csv(CSV)
     rows = rows[np.isclose(rows.k0, k0) & np.isclose(rows.d, d) & (rows.status == "ok")]
-    # a row is a check only where its shocks stand apart from the other avalanches: the
-    # smallest shock at least twice the threshold, the largest other avalanche below half of it
-    clean = (rows.shock_size_min >= 2.0 * rows.shock_fraction) & (rows.largest_subthreshold <= 0.5 * rows.shock_fraction)
+    clean = separated(rows)
     for r in rows[~clean].itertuples():
         print(f"k0 = {k0:g}, d = {d:g}, N = {r.N:.0f}, seed {r.seed}: left out, its shocks are not separated "
               f"(smallest {r.shock_size_min:.3g} N, largest other avalanche {r.largest_subthreshold:.3g} N, "
