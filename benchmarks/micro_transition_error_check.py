@@ -36,7 +36,7 @@ import micro
 from micro.cohort import cycle_cohorts
 
 from _harness import RESULTS, Stopwatch, pyplot, save_figure, warm_up, write_csv
-from micro_transition_nblock_check import separated
+from micro_transition_nblock_check import pooled, separated
 
 CSV = RESULTS / "micro_transition_error_check.csv"
 NBLOCK_CSV = RESULTS / "micro_transition_nblock_check.csv"
@@ -100,11 +100,9 @@ def plot() -> None:
     nb = nb[nb.k0.isin(list(colour)) & separated(nb) & (nb.status == "ok")] if len(nb) else nb
     sizes = {N: 3 + j for j, N in enumerate(sorted(nb.N.unique()))} if len(nb) else {}
     for (k0, N), g in (nb.groupby(["k0", "N"]) if len(nb) else []):
-        # each (k0, N): the seeds pooled by inverse variance; squares grow with N
-        w = 1.0 / g.amplitude_stderr ** 2
-        pooled = (g.assign(w=w, wa=w * g.amplitude).groupby("d")[["w", "wa"]].sum())
-        ax.errorbar(pooled.index, pooled.wa / pooled.w, yerr=1.0 / np.sqrt(pooled.w), fmt="s", mfc="none",
-                    ms=sizes[N], color=colour[k0], alpha=0.6, lw=0.8)
+        p = pooled(g, "amplitude", "d")  # (each (k0, N): the seeds pooled; squares grow with N)
+        ax.errorbar(p.index, p.value, yerr=p.stderr, fmt="s", mfc="none", ms=sizes[N], color=colour[k0], alpha=0.6,
+                    lw=0.8)
     if len(nb):
         ax.plot([], [], "s", mfc="none", color="k", label="N-block (seeds pooled; shocks separated), larger: larger N "
                 f"({', '.join(f'{N:.0e}' for N in sizes)})")

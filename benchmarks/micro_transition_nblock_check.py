@@ -45,7 +45,16 @@ grows a little faster than N, about 3.6 times per factor 3):
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 1000000 --seed 1
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 30000,100000 --n-cycles 1000 --seed 2
     NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.05 --N 300000 --n-cycles 600 --seed 2
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.01 --N 100000,300000,1000000 --record-every 0.002
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.01 --N 3000000 --record-every 0.002
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.3 --d 0.1 --N 100000,300000,1000000,3000000 --shock-fraction 0.15 --record-every 0.002
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.3 --d 0.05 --N 100000,300000,1000000,3000000 --shock-fraction 0.1 --record-every 0.002
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.3 --d 0.02 --N 100000,300000,1000000,3000000 --shock-fraction 0.05 --record-every 0.002
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.3 --d 0.01 --N 100000,300000,1000000,3000000 --shock-fraction 0.025 --record-every 0.001
+    NUMBA_NUM_THREADS=1 python benchmarks/micro_transition_nblock_check.py --k0 0.3 --d 0.05 --N 10000000 --shock-fraction 0.1 --record-every 0.002
+        # k0 = 0.3: the threshold below the fraction a shock moves (56, 35, 16, 8 %); 4-1443 CPU s a run
     python benchmarks/micro_transition_nblock_check.py --k0 0.01 --d 0.1,0.05 --trend   # the finite-N fits
+    python benchmarks/micro_transition_nblock_check.py --k0 0.3 --d 0.1,0.05 --trend
 """
 from __future__ import annotations
 
@@ -141,6 +150,15 @@ def separated(rows: pd.DataFrame) -> pd.Series:
     return (rows.shock_size_min >= 2.0 * rows.shock_fraction) & (rows.largest_subthreshold <= 0.5 * rows.shock_fraction)
 
 
+def pooled(rows: pd.DataFrame, col: str, by: str) -> pd.DataFrame:
+    """``col`` of the rows pooled by inverse variance within each value of ``by`` (seeds and
+    run lengths at one N, or one d): columns ``value``, ``stderr``, ``runs``, ``cycles``."""
+    w = 1.0 / rows[f"{col}_stderr"] ** 2
+    g = (rows.assign(w=w, wa=w * rows[col]).groupby(by)
+         .agg(w=("w", "sum"), wa=("wa", "sum"), runs=("seed", "size"), cycles=("n_cycles", "sum")))
+    return pd.DataFrame({"value": g.wa / g.w, "stderr": 1.0 / np.sqrt(g.w), "runs": g.runs, "cycles": g.cycles})
+
+
 def trend(k0: float, d: float) -> None:
     """The N-block's finite-N trend at (k0, d), from the CSV: for the amplitude, sigma_max
     and sigma_min, the rows at one N (seeds, run lengths) pooled by inverse variance, then
@@ -166,12 +184,9 @@ def trend(k0: float, d: float) -> None:
 def _trend_of(rows: pd.DataFrame, col: str, k0: float, d: float) -> None:
     from scipy.optimize import curve_fit
 
-    w = 1.0 / rows[f"{col}_stderr"] ** 2
-    by_n = (rows.assign(w=w, wa=w * rows[col]).groupby("N")
-            .agg(w=("w", "sum"), wa=("wa", "sum"), runs=("seed", "size"), cycles=("n_cycles", "sum")))
+    by_n = pooled(rows, col, "N")
     N = by_n.index.to_numpy(float)
-    val = (by_n.wa / by_n.w).to_numpy()
-    err = (1.0 / np.sqrt(by_n.w)).to_numpy()
+    val, err = by_n.value.to_numpy(), by_n.stderr.to_numpy()
     print(f"k0 = {k0:g}, d = {d:g}: {col} by N (seeds and runs pooled)")
     for n, a, e, r, c in zip(N, val, err, by_n.runs, by_n.cycles):
         print(f"  N = {n:9.0f}: {a:.6f} +- {e:.1e}  ({r} runs, {c} shocks)")
