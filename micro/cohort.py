@@ -121,8 +121,9 @@ NEWTON_TOL = 0.5
 #: the loading phase is shorter than SHORT_PHASE and shocks all but total); one that
 #: extrapolated (Aitken) such a sequence without the acceleration says in its message that
 #: its error estimate can miss a slower mode (measured:
-#: benchmarks/micro_cohort_estimate_check.py).  (Where the last steps are below tol / 100,
-#: a mode contracting by up to 0.99 stays within tol.)
+#: benchmarks/micro_cohort_estimate_check.py).  (Steps below tol / 100 say nothing alone:
+#: they can be a stress passing through zero steps; the state's move bounds what remains,
+#: :func:`_state_tail`.)
 SLOW_CAVEAT = 0.9
 #: A step's Newton iteration for its slip starts at this fraction of the slip rate
 #: extrapolated from the two steps before, times its length (:meth:`_Cohorts.root`).
@@ -282,6 +283,14 @@ class _Cohorts:
         out = np.empty(self.pool)
         CK.cell_survivors(self.pool, self.q, self.m, self.h, self.lam, out)
         return out
+
+    def node_masses(self, cell: np.ndarray | None = None) -> np.ndarray:
+        """The delta_R marginal of every block that has not crossed yet (all cohorts), as
+        masses on the nodes (each cell's surviving mass on its lower node; from ``cell``,
+        the cells' masses, if known).  The cells are packed in cohort order."""
+        cell = self.cell_masses() if cell is None else cell
+        node = np.repeat(self.j0[:self.n] - self.off[:self.n], self.nn[:self.n]) + np.arange(self.pool)
+        return np.bincount(node, weights=cell, minlength=self.ny)
 
     def surviving(self, cell: np.ndarray | None = None) -> np.ndarray:
         """The mass of every cohort that has not crossed yet (from ``cell``, the cells'
@@ -809,10 +818,11 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     # (the shock's newborns are the last cohort; not counted by index from before the
     # shock, since storing them may have compacted the cohorts)
     unjumped = float(st.surviving(cell)[:-1].sum())
+    marginal = st.node_masses(cell)
     st.compact(cell)
     return dict(ok=True, sigma_max=peak, sigma_min=trough, period=period,
                 sigma_mean=integral / period if period > 0 else sigma_before, sigma_before=sigma_before,
-                sigma_after=st.sigma, unjumped=unjumped, start=sigma_start, steps=steps)
+                sigma_after=st.sigma, unjumped=unjumped, start=sigma_start, steps=steps, marginal=marginal)
 
 
 def _trace(out: dict, k0: float, V: float) -> tuple[np.ndarray, np.ndarray]:
@@ -830,6 +840,14 @@ COLUMNS = ("sigma_max", "sigma_min", "period", "sigma_mean", "sigma_before", "si
 JUDGED = (0, 1, 4, 5)
 #: Cycles an estimate needs: three Aitken extrapolations, from three pairs of differences.
 WINDOW = 5
+#: The stresses' response to the state's move (:func:`_state_tail`) is the largest over this
+#: many cycles: it falls as the fast modes die (at k0 = 0.3, 0.95 V^c from 1e-2 to 1e-3 of
+#: stress per unit of mass over 40 cycles, so that the largest over the whole run claimed 30
+#: times the distance), and over five cycles the stresses can all be near zero steps (at
+#: k0 = 0.3, 0.99 V^c, dt = 0.01 it claimed 3.0e-5 where 3.7e-5 remained; ten and twenty
+#: cycles covered every cycle of the three sequences replayed: docs/validation/micro_cohort.md,
+#: section 5).
+SENSITIVITY_WINDOW = 10
 
 
 def _estimate(a: np.ndarray, tol: float, slowest: float = 0.0) -> tuple[np.ndarray, list[str], np.ndarray, np.ndarray]:
@@ -889,6 +907,41 @@ def _estimate(a: np.ndarray, tol: float, slowest: float = 0.0) -> tuple[np.ndarr
     return errors, how, best, rho
 
 
+def _state_tail(a: np.ndarray, moves: np.ndarray, kinks: np.ndarray, slowest: float = 0.0) -> tuple[float, float]:
+    """How far the judged quantities (JUDGED columns of ``a``, one row per cycle: stresses
+    of the cycle) can still be from the fixed point, as the state's last move bounds it,
+    and the multiplier used.  ``moves``: the state's move over each cycle, the L1 norm of
+    the change of the surviving blocks' delta_R marginal (row k: from cycle k - 1 to k;
+    row 0 unused); ``kinks``: the rows whose loading phase took a different number of
+    steps than the row before (the map's discontinuities, where a stress jumps by the
+    discretisation's sawtooth whatever the state does).
+
+    A quantity's own steps can pass through zero while the state still moves (modes of
+    opposite signs, the new transient after a kink): at k0 = 0.3, 0.99 V^c (dt = 0.01)
+    the steps of sigma_max fell below tol / 100 for two cycles where 3.7e-5 remained
+    (docs/validation/micro_cohort.md, section 5, "A stress passing through zero steps").  The state's move, a norm, cannot
+    pass through zero.  So each stress is at least ``S n m / (1 - m)`` from the fixed
+    point: ``n`` the state's last move; ``m`` the larger of its largest ratio of
+    successive moves over the last WINDOW cycles and ``slowest`` (the model's slowest
+    multiplier), at most AITKEN_MAX_RATIO; ``S`` the largest step of any judged stress per
+    unit of the state's move over the last SENSITIVITY_WINDOW rows but kinks (the stresses
+    of one cycle respond alike: one of them can be passing through zero when another is
+    not).  0 where the state did not move."""
+    n = np.asarray(moves, float)[1:]
+    if not n[-1] > 0.0:
+        return 0.0, 0.0
+    w = n[-(WINDOW - 1):]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = float(np.max(w[1:] / w[:-1]))
+    m = min(max(ratio if math.isfinite(ratio) else 1.0, slowest), AITKEN_MAX_RATIO)
+    rows = (n > 0.0) & ~np.asarray(kinks, bool)[1:]
+    rows[:-SENSITIVITY_WINDOW] = False
+    if not rows.any():
+        rows = n > 0.0
+    steps = np.abs(np.diff(a[:, list(JUDGED)], axis=0))[rows]
+    return float((steps / n[rows, None]).max()) * float(n[-1]) * m / (1.0 - m), m
+
+
 def _relaxation_multiplier(model: Model, period: float) -> float:
     """The cycle map's slowest multiplier as the model gives it beforehand: between shocks a
     block's delta_R relaxes alone, by ``1 - alpha (1 - exp(-gamma T))`` over a cycle of
@@ -943,9 +996,11 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     and each error is the largest of its last Newton step's change, the plain cycles'
     estimate after it and their distance from its fixed point.  ``error`` is the error of
     the fixed point at this ``dt`` and ``h``, not
-    their discretisation error (``h`` defaults to ``kappa zbar / 20``).  Close to V^c
-    without the acceleration (shocks that leave many blocks, k0 = 0.1, 0.3) five cycles
-    can hide a slower mode, and the message then says so.  ``dt``
+    their discretisation error (``h`` defaults to ``kappa zbar / 20``).  Without the
+    acceleration each error is also at least what the state's last move leaves
+    (:func:`_state_tail`: a stress's own steps can pass through zero while the state still
+    moves).  Close to V^c without the acceleration (shocks that leave many blocks,
+    k0 = 0.1, 0.3) five cycles can hide a slower mode, and the message then says so.  ``dt``
     is the step of loading phases longer than SHORT_PHASE, within ``1 / gamma`` of their
     ends (up to four times longer between: :func:`_step_length`); shorter ones (close to
     V^c) get steps ``dt * T / SHORT_PHASE`` (a fiftieth of T at the default dt).
@@ -991,6 +1046,12 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     # V^c: this run is accelerated at its first cycle, not after WINDOW plain ones
     eager = bool(getattr(given if given is not None else coarse, "accelerated", False))
     hist: list[tuple[float, ...]] = []
+    # the state's move over each cycle of hist (the L1 change of the surviving blocks'
+    # delta_R marginal; nan for the first after a new start), and the marginal it is from
+    moves: list[float] = []
+    previous = st.node_masses()
+    kinks: list[bool] = []  # (the cycles of hist whose loading phase changed its number of steps)
+    n_steps = 0
     error, converged, applicable, message = math.nan, False, True, ""
     value = np.full(len(COLUMNS), math.nan)
     out: dict = {}
@@ -1018,14 +1079,29 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             # steps, and start the sequence again at the new step
             step = _phase_step(out["period"], dt)
             hist.clear()
+            moves.clear()
+            kinks.clear()
+            previous = out["marginal"]
             passed = 0
             continue
         hist.append(tuple(out[name] for name in COLUMNS))
+        moves.append(float(np.abs(out["marginal"] - previous).sum()) if len(hist) > 1 else math.nan)
+        previous = out["marginal"]
+        kinks.append(len(hist) > 1 and len(out["steps"]) != n_steps)
+        n_steps = len(out["steps"])
         # (INFO: the progress within a row that `micro sweep -v` shows; each cycle is one step of the iteration)
         log.info("cohort k0=%g V=%g h=%.3g cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f",
                  model.k0, V, h, it, out["sigma_max"], out["sigma_min"], out["sigma_before"])
         if len(hist) >= WINDOW:
-            errors, how, best, rho = _estimate(np.array(hist), tol, _relaxation_multiplier(model, out["period"]))
+            slowest = _relaxation_multiplier(model, out["period"])
+            errors, how, best, rho = _estimate(np.array(hist), tol, slowest)
+            if not accelerated:
+                # a quantity's steps can pass through zero while the state still moves: its
+                # error is at least what the state's last move leaves (:func:`_state_tail`)
+                tail, _ = _state_tail(np.array(hist), np.array(moves), np.array(kinks), slowest)
+                for i in JUDGED:
+                    if tail > errors[i]:
+                        errors[i], how[i] = tail, "state's move"
             if accelerated and 0.0 < slow_multiplier < 1.0:
                 # after the acceleration the sequence holds what the map's slowest modes
                 # left: a last step d leaves up to d m / (1 - m) to go (m the slowest
@@ -1036,7 +1112,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             # (steps too small to show a ratio, but not small enough for the slowest mode's
             # tail: a slow sequence as well)
             slow = any((how[i] in ("Aitken", "slow") and rho[i] > SLOW_CAVEAT)
-                       or (how[i] in ("last steps", "noise") and errors[i] > tol) for i in JUDGED)
+                       or (how[i] in ("last steps", "noise", "state's move") and errors[i] > tol) for i in JUDGED)
         elif eager and not accelerated:
             slow = True  # (the start's own run was accelerated: so is this one, at once)
         else:
@@ -1072,6 +1148,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             if fast is not None:
                 st = fast
                 hist.clear()
+                moves.clear()
+                kinks.clear()
+                previous = st.node_masses()
                 passed = 0
                 continue
         if len(hist) < WINDOW:
@@ -1102,6 +1181,9 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 if newton.certified:
                     st = newton.state
                     hist.clear()
+                    moves.clear()
+                    kinks.clear()
+                    previous = st.node_masses()
                     passed = 0
                     continue
             # the frozen map grows along some mode: it gives no bound on what a slower mode of

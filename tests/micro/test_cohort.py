@@ -434,6 +434,36 @@ def test_an_extrapolation_does_not_claim_past_a_slow_mode_it_has_not_seen():
     assert how[0] == "Aitken" and errors[0] >= abs(best[0] - 0.9)
 
 
+def test_a_stress_passing_through_zero_steps_is_bounded_by_the_state_s_move():
+    """Two modes of the state (multipliers 0.97, the model's slowest, and 0.9) move
+    sigma_max with opposite signs, so that its steps pass through zero: the rules on its
+    own steps call it noise and claim a sixth of the distance (at k0 = 0.3, 0.99 V^c the
+    cohort method claimed 1.1e-5 where 3.7e-5 remained, docs/validation/micro_cohort.md
+    section 5).  The state's move, a norm, does not pass through zero, and the other
+    stresses of the cycle (here sigma_min, on both modes with one sign) show how far the
+    stresses move with it: the bound covers the distance.  A kink (a stress jumping where
+    the loading phase changes its number of steps) does not set that response."""
+    from micro.cohort import _estimate, _state_tail
+    n = np.arange(24)
+    u, v = 0.5 * 0.97 ** n, 0.15 * (0.97 / 0.9) ** 21.5 * 0.9 ** n  # (the modes, in mass)
+    a = np.tile((0.9 + 1e-3 * (u - v))[:, None], (1, 6))
+    a[:, 1] = 0.89 - 1e-3 * (u + 0.2 * v)
+    moves = np.concatenate([[np.nan], np.abs(np.diff(u)) + np.abs(np.diff(v))])
+    kinks = np.zeros(n.size, bool)
+    errors, how, best, _ = _estimate(a, 2e-5, 0.97)
+    distance = abs(best[0] - 0.9)
+    assert how[0] == "noise" and errors[0] < distance / 3 and distance > 1.5e-4
+    tail, m = _state_tail(a, moves, kinks, 0.97)
+    assert m == 0.97 and distance <= tail < 3 * distance
+    a[18:, 4] += 1e-4  # (sigma_before jumps by 1e-4 at row 18)
+    kinks[18] = True
+    assert _state_tail(a, moves, kinks, 0.97)[0] == pytest.approx(tail, rel=1e-12)
+    kinks[18] = False
+    assert _state_tail(a, moves, kinks, 0.97)[0] > 4 * tail
+    moves[-1] = 0.0  # (a state that did not move: nothing left)
+    assert _state_tail(a, moves, kinks, 0.97) == (0.0, 0.0)
+
+
 def test_anderson_beats_the_plain_cycles_close_to_vc():
     # k0 = 0.01, 0.9 V^c: the cycle map contracts by about 0.96 per cycle; fifteen cycles'
     # worth of Anderson's acceleration leaves a smaller residual than fifteen plain cycles
