@@ -464,6 +464,15 @@ def test_a_stress_passing_through_zero_steps_is_bounded_by_the_state_s_move():
     assert _state_tail(a, moves, kinks, 0.97) == (0.0, 0.0)
 
 
+def test_a_run_on_plain_cycles_takes_the_state_s_move_as_a_bound():
+    """Where shocks leave many blocks (k0 = 0.3, 0.9 V^c: 44 %) the run iterates plain
+    cycles, and the bound of the state's move is what it reports (its message names it)."""
+    model = micro.Model(k0=0.3)
+    res = cycle_cohorts(model, 0.9 * micro.critical_velocity(model).Vc, dt=0.02, tol=1e-4)
+    assert res.converged and not res.accelerated and res.error <= 1e-4, res.message
+    assert "(state's move)" in res.message, res.message
+
+
 def test_anderson_beats_the_plain_cycles_close_to_vc():
     # k0 = 0.01, 0.9 V^c: the cycle map contracts by about 0.96 per cycle; fifteen cycles'
     # worth of Anderson's acceleration leaves a smaller residual than fifteen plain cycles
