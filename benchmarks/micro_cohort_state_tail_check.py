@@ -39,7 +39,6 @@ from micro import cohort as C
 from _harness import RESULTS, Stopwatch, warm_up, write_csv
 
 OUT = RESULTS / "micro_cohort_state_tail_check.csv"
-STRESSES = [C.COLUMNS[i] for i in C.JUDGED]
 
 
 def record(k0: float, frac: float, dt: float, tol: float, cycles: int) -> pd.DataFrame:
@@ -77,19 +76,19 @@ def replay(seq: pd.DataFrame, tol: float) -> None:
     moves = seq.move.to_numpy().copy()
     moves[0] = np.nan
     steps = seq.steps.to_numpy()
-    kinks = np.concatenate([[False], steps[1:] != steps[:-1]])
+    kinks = np.flatnonzero(steps[1:] != steps[:-1]) + 1  # (printed only: _state_tail finds them itself)
     r = (moves[-1] / moves[-11]) ** 0.1
     last = a[-1] - a[-2]
     limit = a[-1] + last * r / (1.0 - r)
     judged = list(C.JUDGED)
     print(f"k0 = {k0:g}, {frac:g} V^c, dt = {seq.dt.iloc[0]:g}: {len(a)} cycles, state contraction {r:.4f}, "
           f"limit sigma_max {limit[0]:.8f} sigma_min {limit[1]:.8f} (its tail {np.abs(last * r / (1 - r))[judged].max():.1e}); "
-          f"kinks at cycles {np.flatnonzero(kinks).tolist()}")
+          f"kinks at cycles {kinks.tolist()}")
     passed, stopped = {"before": 0, "now": 0}, set()
     for n in range(C.WINDOW, len(a) + 1):
         slowest = C._relaxation_multiplier(model, a[n - 1, 2])
         errors, how, best, _ = C._estimate(a[:n], tol, slowest)
-        tail, m = C._state_tail(a[:n], moves[:n], kinks[:n], slowest)
+        tail, m = C._state_tail(a[:n], moves[:n], steps[:n], slowest)
         true = float(np.abs(best - limit)[judged].max())
         for rule, claim in (("before", float(errors[judged].max())), ("now", max(float(errors[judged].max()), tail))):
             passed[rule] = passed[rule] + 1 if claim <= tol else 0

@@ -908,14 +908,15 @@ def _estimate(a: np.ndarray, tol: float, slowest: float = 0.0) -> tuple[np.ndarr
     return errors, how, best, rho
 
 
-def _state_tail(a: np.ndarray, moves: np.ndarray, kinks: np.ndarray, slowest: float = 0.0) -> tuple[float, float]:
+def _state_tail(a: np.ndarray, moves: np.ndarray, steps: np.ndarray, slowest: float = 0.0) -> tuple[float, float]:
     """How far the judged quantities (JUDGED columns of ``a``, one row per cycle: stresses
     of the cycle) can still be from the fixed point, as the state's last move bounds it,
     and the multiplier used.  ``moves``: the state's move over each cycle, the L1 norm of
     the change of the surviving blocks' delta_R marginal (row k: from cycle k - 1 to k;
-    row 0 unused); ``kinks``: the rows whose loading phase took a different number of
-    steps than the row before (the map's discontinuities, where a stress jumps by the
-    discretisation's sawtooth whatever the state does).
+    row 0 unused); ``steps``: the number of steps of each row's cycle.  A row whose
+    loading phase took a different number of steps than the row before is a kink (the
+    map's discontinuity, where a stress jumps by the discretisation's sawtooth whatever
+    the state does).
 
     A quantity's own steps can pass through zero while the state still moves (modes of
     opposite signs, the new transient after a kink): at k0 = 0.3, 0.99 V^c (dt = 0.01)
@@ -935,12 +936,13 @@ def _state_tail(a: np.ndarray, moves: np.ndarray, kinks: np.ndarray, slowest: fl
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = float(np.max(w[1:] / w[:-1]))
     m = min(max(ratio if math.isfinite(ratio) else 1.0, slowest), AITKEN_MAX_RATIO)
-    rows = (n > 0.0) & ~np.asarray(kinks, bool)[1:]
+    steps = np.asarray(steps)
+    rows = (n > 0.0) & (steps[1:] == steps[:-1])  # (kinks left out)
     rows[:-SENSITIVITY_WINDOW] = False
     if not rows.any():
         rows = n > 0.0
-    steps = np.abs(np.diff(a[:, list(JUDGED)], axis=0))[rows]
-    return float((steps / n[rows, None]).max()) * float(n[-1]) * m / (1.0 - m), m
+    change = np.abs(np.diff(a[:, list(JUDGED)], axis=0))[rows]
+    return float((change / n[rows, None]).max()) * float(n[-1]) * m / (1.0 - m), m
 
 
 def _relaxation_multiplier(model: Model, period: float) -> float:
@@ -1051,8 +1053,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     # delta_R marginal; nan for the first after a new start), and the marginal it is from
     moves: list[float] = []
     previous = st.node_masses()
-    kinks: list[bool] = []  # (the cycles of hist whose loading phase changed its number of steps)
-    n_steps = 0
+    counts: list[int] = []  # (the number of steps of each cycle of hist: where it changes, a kink)
     error, converged, applicable, message = math.nan, False, True, ""
     value = np.full(len(COLUMNS), math.nan)
     out: dict = {}
@@ -1081,25 +1082,25 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
             step = _phase_step(out["period"], dt)
             hist.clear()
             moves.clear()
-            kinks.clear()
+            counts.clear()
             previous = out["marginal"]
             passed = 0
             continue
         hist.append(tuple(out[name] for name in COLUMNS))
         moves.append(float(np.abs(out["marginal"] - previous).sum()) if len(hist) > 1 else math.nan)
         previous = out["marginal"]
-        kinks.append(len(hist) > 1 and len(out["steps"]) != n_steps)
-        n_steps = len(out["steps"])
+        counts.append(len(out["steps"]))
         # (INFO: the progress within a row that `micro sweep -v` shows; each cycle is one step of the iteration)
         log.info("cohort k0=%g V=%g h=%.3g cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f",
                  model.k0, V, h, it, out["sigma_max"], out["sigma_min"], out["sigma_before"])
         if len(hist) >= WINDOW:
             slowest = _relaxation_multiplier(model, out["period"])
-            errors, how, best, rho = _estimate(np.array(hist), tol, slowest)
+            a = np.array(hist)
+            errors, how, best, rho = _estimate(a, tol, slowest)
             if not accelerated:
                 # a quantity's steps can pass through zero while the state still moves: its
                 # error is at least what the state's last move leaves (:func:`_state_tail`)
-                tail, _ = _state_tail(np.array(hist), np.array(moves), np.array(kinks), slowest)
+                tail, _ = _state_tail(a, np.array(moves), np.array(counts), slowest)
                 for i in JUDGED:
                     if tail > errors[i]:
                         errors[i], how[i] = tail, "state's move"
@@ -1107,7 +1108,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 # after the acceleration the sequence holds what the map's slowest modes
                 # left: a last step d leaves up to d m / (1 - m) to go (m the slowest
                 # multiplier, of the map at frozen slips)
-                last = np.abs(np.diff(np.array(hist)[-2:], axis=0)[0])
+                last = np.abs(np.diff(a[-2:], axis=0)[0])
                 errors = np.maximum(errors, last * slow_multiplier / (1.0 - slow_multiplier))
             error = float(errors[list(JUDGED)].max())
             # (steps too small to show a ratio, but not small enough for the slowest mode's
@@ -1150,7 +1151,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                 st = fast
                 hist.clear()
                 moves.clear()
-                kinks.clear()
+                counts.clear()
                 previous = st.node_masses()
                 passed = 0
                 continue
@@ -1183,7 +1184,7 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
                     st = newton.state
                     hist.clear()
                     moves.clear()
-                    kinks.clear()
+                    counts.clear()
                     previous = st.node_masses()
                     passed = 0
                     continue

@@ -449,19 +449,19 @@ def test_a_stress_passing_through_zero_steps_is_bounded_by_the_state_s_move():
     a = np.tile((0.9 + 1e-3 * (u - v))[:, None], (1, 6))
     a[:, 1] = 0.89 - 1e-3 * (u + 0.2 * v)
     moves = np.concatenate([[np.nan], np.abs(np.diff(u)) + np.abs(np.diff(v))])
-    kinks = np.zeros(n.size, bool)
+    steps = np.full(n.size, 50)  # (every loading phase in 50 steps: no kink)
     errors, how, best, _ = _estimate(a, 2e-5, 0.97)
     distance = abs(best[0] - 0.9)
     assert how[0] == "noise" and errors[0] < distance / 3 and distance > 1.5e-4
-    tail, m = _state_tail(a, moves, kinks, 0.97)
+    tail, m = _state_tail(a, moves, steps, 0.97)
     assert m == 0.97 and distance <= tail < 3 * distance
     a[18:, 4] += 1e-4  # (sigma_before jumps by 1e-4 at row 18)
-    kinks[18] = True
-    assert _state_tail(a, moves, kinks, 0.97)[0] == pytest.approx(tail, rel=1e-12)
-    kinks[18] = False
-    assert _state_tail(a, moves, kinks, 0.97)[0] > 4 * tail
+    steps[18:] = 49  # (a kink: from row 18 on the loading phase takes a step less)
+    assert _state_tail(a, moves, steps, 0.97)[0] == pytest.approx(tail, rel=1e-12)
+    steps[18:] = 50
+    assert _state_tail(a, moves, steps, 0.97)[0] > 4 * tail
     moves[-1] = 0.0  # (a state that did not move: nothing left)
-    assert _state_tail(a, moves, kinks, 0.97) == (0.0, 0.0)
+    assert _state_tail(a, moves, steps, 0.97) == (0.0, 0.0)
 
 
 def test_a_run_on_plain_cycles_takes_the_state_s_move_as_a_bound():
