@@ -34,7 +34,9 @@ process pool or dask); the RS side is fast and recomputed each time.
 """
 from __future__ import annotations
 
+import contextlib
 import logging
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,7 +44,7 @@ from typing import Any, Sequence
 
 import pandas as pd
 
-from . import figures
+from . import figures, rs_side
 from ._validation import positive
 from .cache import NullCache, PointCache
 from .context import SHARED_FIGURES, Context, micro_frame
@@ -125,6 +127,27 @@ def _prefetch(ctx: Context, scenarios: Sequence) -> None:
     ctx.run(sorted(tasks, key=lambda t: _SLOWEST_FIRST.get(t.kind, 0)), "micro")
 
 
+@contextlib.contextmanager
+def _rsf_compiled_beside(runner: Runner):
+    """While the pool's workers compile and run micro's tasks, this process compiles rsf's
+    kernels in a thread (:func:`compare.rs_side.warm_up`; this process only waits for the
+    workers then).  A failure there is logged, not raised: the real call raises it."""
+    if not runner.mode.startswith("process pool"):
+        yield
+        return
+
+    def warm() -> None:
+        try:
+            log.info("rsf kernels ready after %.1f s", rs_side.warm_up())
+        except Exception as exc:  # noqa: BLE001 - the scenario's own call reports it
+            log.warning("compiling rsf's kernels ahead failed: %s", exc)
+
+    thread = threading.Thread(target=warm, name="rsf-warm-up", daemon=True)
+    thread.start()
+    yield  # (on Ctrl-C the daemon thread is not waited for)
+    thread.join()
+
+
 def report(settings: Settings | None = None, *, out: str | Path | None = None,
            scenarios: Sequence[str] | None = None, Dc: float | None = None, cache_dir: str | Path | None = None,
            use_cache: bool = True, workers: int | None = None, scheduler: Any = None,
@@ -190,7 +213,8 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
     try:
         with Runner(cache, workers=workers, scheduler=scheduler, progress=progress) as runner:
             ctx = Context(settings, runner, Dc)
-            _prefetch(ctx, selected)
+            with _rsf_compiled_beside(runner):
+                _prefetch(ctx, selected)
             parts = []
             for sc in selected:
                 log.info("scenario %s", sc.NAME)

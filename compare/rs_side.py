@@ -10,6 +10,7 @@ r"""The rate-and-state side of the comparison, on top of :mod:`rsf` (fast, not c
 from __future__ import annotations
 
 import math
+import time
 from typing import Callable, Sequence
 
 import numpy as np
@@ -19,7 +20,7 @@ import rsf
 
 from ._validation import positive
 
-__all__ = ["rs_curves", "rs_hopf", "rs_slide_hold_slide", "classical_rs", "DEFAULT_OPTIONS"]
+__all__ = ["rs_curves", "rs_hopf", "rs_slide_hold_slide", "classical_rs", "warm_up", "DEFAULT_OPTIONS"]
 
 #: Limit cycles to 1e-7 (relative), CVODE rtol 1e-8: far below the micro errors.
 DEFAULT_OPTIONS = rsf.SolverOptions(cycle_rtol=1e-7, rtol=1e-8)
@@ -253,3 +254,17 @@ def classical_rs(law: rsf.SteadyStateLaw, V: float, b: float, k0: float, Dc: flo
         raise ValueError(f"b must be > W(V) = {W!r} so that a = b - W(V) > 0, got {b!r}")
     mu0 = float(law.mu_ss(np.array([V]))[0])
     return rsf.SpringSlider(law=rsf.LogLaw(mu0=mu0, a=b - W, b=b, v0=V), k0=k0, Dc=Dc)
+
+
+def warm_up() -> float:
+    """Compile (or load from numba's disk cache) the rsf kernels the report uses, with
+    tiny runs of each kind of call (curves with their limit cycles on Eq. 11, and a
+    slide-hold-slide of the classical law, Eq. 7); returns the seconds it took.  The
+    report runs it in a thread of its own process while the pool's workers compile micro's
+    kernels, so that the two compilations overlap on a fresh install."""
+    start = time.perf_counter()
+    rs_curves([0.1], lambda k0: rsf.HyperbolicLaw(), 0.06, V_range=lambda k0: (0.5, 5.0), n=4)
+    law = rsf.HyperbolicLaw().bind(0.1)
+    rs_slide_hold_slide(classical_rs(law, 1.0, 0.02, 0.1, 0.06), 1.0, [1.0])
+    rs_slide_hold_slide(rsf.SpringSlider(k0=0.1), 1.0, [1.0])
+    return time.perf_counter() - start

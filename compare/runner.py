@@ -6,8 +6,8 @@ computed
 
 * in this process when ``workers == 1`` (no pool; what the tests compare against),
 * on a local process pool by default (``workers`` processes, ``spawn`` start method; the
-  numba kernels are compiled once in the parent first so that every worker only loads
-  them from numba's disk cache),
+  workers compile micro's numba kernels first, each group of kernels on one worker, all
+  at once; later processes load them from numba's disk cache),
 * on a dask.distributed cluster when ``scheduler`` is an address such as
   ``tcp://10.0.0.5:8786`` (or a ``distributed.Client``).  The workers need ``micro`` and
   ``compare`` importable; results come back to this process, which alone writes the
@@ -36,7 +36,7 @@ from micro._threads import available_cores
 
 from ._validation import positive_int
 from .cache import NullCache, PointCache
-from .tasks import Task, execute, warm_up
+from .tasks import WARM_GROUPS, Task, execute, warm_up
 
 __all__ = ["Runner", "RunStats"]
 
@@ -100,7 +100,6 @@ def _worker_init(parent_pid: int) -> None:
     from micro._threads import single_thread_process
 
     single_thread_process()
-    warm_up()
 
 
 def _die_with_parent(parent_pid: int) -> None:
@@ -313,27 +312,11 @@ class Runner:
 
     def _compute_pool(self, todo: list[Task]) -> Iterable[dict[str, Any]]:
         if self._pool is None:
-            self._ensure_warm()  # compile once here; workers then load numba's disk cache
-            self._pool = ProcessPoolExecutor(max_workers=self.workers,
-                                             mp_context=multiprocessing.get_context("spawn"),
-                                             initializer=_worker_init, initargs=(os.getpid(),))
-        # one BLAS (and numba) thread per worker: the workers already fill the cores, and
-        # OpenBLAS threads competing with another worker's made micro's direct solver 4-8x
-        # slower (measured); the spawned workers read these when they import numpy and numba
-        saved = {var: os.environ.get(var) for var in _THREADS}
-        os.environ.update({var: "1" for var in _THREADS})
-        try:
-            # submit() spawns the workers: a Ctrl-C or SIGTERM in the middle of writing a new
-            # worker's start-up data to its pipe left that worker to die printing a traceback
-            # ("EOFError: Ran out of input"); the signal is acted on once the submits are done
-            with _signals_deferred():
-                pending: set[Future] = {self._pool.submit(execute, task) for task in todo}
-        finally:
-            for var, value in saved.items():
-                if value is None:
-                    os.environ.pop(var, None)
-                else:
-                    os.environ[var] = value
+            self._start_pool()
+        # submit() hands the tasks to the workers' queue; a Ctrl-C or SIGTERM in the middle
+        # of it is acted on once the submits are done
+        with _signals_deferred():
+            pending: set[Future] = {self._pool.submit(execute, task) for task in todo}
         try:
             while pending:
                 done, pending = wait(pending, return_when=FIRST_COMPLETED)
@@ -345,6 +328,44 @@ class Runner:
             # the pool's manager thread fails them itself once its workers are gone.
             self.close(kill=True)
             raise
+
+    def _start_pool(self) -> None:
+        """Start the workers and have them compile micro's kernels, each group once
+        (:data:`compare.tasks.WARM_GROUPS`), all workers at once: the groups compile
+        independently, so on 2 cores this takes about half the time of compiling them in
+        one process, and each is compiled by one worker only (a task given to a worker
+        before its group was in numba's disk cache would compile it again).  With a full
+        disk cache each group is a load of a second or less."""
+        pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=_worker_init, initargs=(os.getpid(),))
+        # one BLAS (and numba) thread per worker: the workers already fill the cores, and
+        # OpenBLAS threads competing with another worker's made micro's direct solver 4-8x
+        # slower (measured); the spawned workers read these when they import numpy and numba
+        saved = {var: os.environ.get(var) for var in _THREADS}
+        os.environ.update({var: "1" for var in _THREADS})
+        try:
+            # submit() spawns the workers: a Ctrl-C or SIGTERM in the middle of writing a new
+            # worker's start-up data to its pipe left that worker to die printing a traceback
+            # ("EOFError: Ran out of input"); the signal is acted on once the submits are done
+            with _signals_deferred():
+                warming = [pool.submit(warm_up, (name,)) for name in WARM_GROUPS]
+        finally:
+            for var, value in saved.items():
+                if value is None:
+                    os.environ.pop(var, None)
+                else:
+                    os.environ[var] = value
+        self._pool = pool
+        start = time.perf_counter()
+        try:
+            for fut in warming:
+                fut.result()
+        except BaseException:
+            self.close(kill=True)
+            raise
+        seconds = time.perf_counter() - start
+        self.stats.warm_up_seconds += seconds
+        log.info("micro kernels ready on %d workers after %.1f s", self.workers, seconds)
 
     def _compute_dask(self, todo: list[Task]) -> Iterable[dict[str, Any]]:
         try:

@@ -236,3 +236,42 @@ def test_cached_records_keep_their_key_order(tmp_path):
     record = {"key": "ab" * 32, "result": {"k0": 0.1, "V": 2.0, "regime": "steady", "eps": 0.01}}
     cache.put(record["key"], record)
     assert list(cache.get(record["key"])["result"]) == ["k0", "V", "regime", "eps"]
+
+
+@pytest.mark.slow
+def test_a_fresh_pool_compiles_each_kernel_once_and_every_group_of_them(tmp_path):
+    """With an empty numba cache a pool of two compiles micro's kernels on its workers,
+    each group on one worker (compare.tasks.WARM_GROUPS), so that every kernel is saved
+    to the cache exactly once, and the tasks after it compile nothing more; the parent,
+    which only waits, compiles none of them (it did all of them alone before)."""
+    import subprocess
+    import sys
+    from collections import Counter
+
+    code = (
+        "import micro\n"
+        "from compare.cache import NullCache\n"
+        "from compare.runner import Runner\n"
+        "from compare.tasks import StationaryTask, VcTask\n"
+        "m = micro.Model(k0=0.3)\n"
+        "tasks = [VcTask(m), StationaryTask(m, 0.05, micro.Numerics(eps=0.05)),"
+        " StationaryTask(micro.Model(k0=0.1), 2.0, micro.Numerics(eps=0.05))]\n"
+        "with Runner(NullCache(), workers=2, progress=False) as r:\n"
+        "    recs = r.run(tasks)\n"
+        "print('STATUS', [rec['status'] for rec in recs])\n"
+        "from micro import _cohort_kernels, _fp_kernels, _renewal_kernels\n"
+        "loaded = [f.__name__ for mod in (_cohort_kernels, _fp_kernels, _renewal_kernels)"
+        " for f in vars(mod).values() if getattr(f, 'signatures', None)]\n"
+        "print('PARENT', loaded)\n"
+    )
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), NUMBA_DEBUG_CACHE="1")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "STATUS ['ok', 'ok', 'ok']" in out.stdout
+    assert "PARENT []" in out.stdout
+    saved = Counter(line.rsplit("/", 1)[-1] for line in out.stdout.splitlines() if "data saved to" in line)
+    assert saved, "nothing was compiled: the numba cache was not empty"
+    twice = {name: n for name, n in saved.items() if n > 1}
+    assert not twice, f"compiled more than once: {twice}"
+    modules = {name.split(".")[0] for name in saved}
+    assert {"_cohort_kernels", "_fp_kernels", "_nblock_kernels", "_renewal_kernels"} <= modules

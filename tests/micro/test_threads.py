@@ -177,11 +177,10 @@ def test_single_thread_process_pins_numba_and_blas():
 
 def test_compare_pool_workers_run_on_one_thread():
     """compare's pool initializer pins its worker to one numba and one BLAS thread even
-    when the environment would allow more (its warm-up is skipped here)."""
+    when the environment would allow more."""
     assert _run("""
         import os, numba, threadpoolctl
         import compare.runner as R
-        R.warm_up = lambda: 0.0
         R._worker_init(os.getppid())
         from micro import _threads
         blas = [lib["num_threads"] for lib in threadpoolctl.threadpool_info() if lib["user_api"] == "blas"]
