@@ -808,13 +808,29 @@ class StickSlipExtrema:
     result: NBlockResult = field(repr=False)
 
 
+#: ``n_discard="auto"``: at least this many shocks are discarded (and at least
+#: ``n_cycles``); while the last ``2 n_cycles`` drift, the run goes on by ``n_cycles``
+#: shocks at a time, up to ``max_discard``.
+AUTO_MIN_DISCARD = 10
+
+
+def _continued_seed(seed: int, segment: int) -> int:
+    """The pinning landscape of a run's ``segment``-th continuation: wells are independent
+    of the past (they are renewed at each jump), so a fresh landscape continues the run
+    exactly, where the same seed would repeat each block's well sequence from its start."""
+    if segment == 0:
+        return seed
+    return (seed ^ ((segment * 0x9E3779B97F4A7C15) & 0xFFFFFFFFFFFFFFFF)) % 2**64
+
+
 def stick_slip_extrema_nblock(
     model: Model,
     velocity: float,
     n_blocks: int,
     *,
     n_cycles: int = 20,
-    n_discard: int = 10,
+    n_discard: int | str = "auto",
+    max_discard: int = 1000,
     t_max: float | None = None,
     seed: int = 0,
     initial: str | NBlockState = "relaxed",
@@ -829,6 +845,16 @@ def stick_slip_extrema_nblock(
     ``shock_fraction * N`` jumps) have occurred, or until ``t_max`` (default
     ``(n_discard + n_cycles + 1) * 2 f_th / (k0 V)``, twice the time the drive needs to load
     the stress by f_th per cycle). The first ``n_discard`` shocks are the transient.
+    With ``n_discard="auto"`` (the default) the transient is as long as it needs to be: at
+    least ``max(AUTO_MIN_DISCARD, n_cycles)`` shocks (``AUTO_MIN_DISCARD`` = 10), then,
+    while the last ``2 n_cycles`` shocks drift (a linear trend in sigma_max or sigma_min of
+    more than three standard errors, their correlation included: the cycles to be used and
+    as many before them, a longer window than the status's own test, which sees less), the
+    run goes on by ``n_cycles`` more shocks and the window moves with it, up to
+    ``max_discard`` discarded shocks (close to V^c the cycle map contracts by about 0.96 a
+    cycle: hundreds of shocks).  Each continuation draws a
+    fresh pinning landscape (the wells are renewed at every jump, so this continues the
+    same process).
 
     Parameters
     ----------
@@ -838,16 +864,22 @@ def stick_slip_extrema_nblock(
         The drive velocity, > 0.
     n_cycles : int
         Shocks to average over, an integer in [2, 1e6] (default 20).
-    n_discard : int
-        Shocks discarded first, in [0, 1e6] (default 10).
+    n_discard : int or "auto"
+        Shocks discarded first, in [0, 1e6], or ``"auto"`` (default; above).
+    max_discard : int
+        With ``n_discard="auto"``, the most shocks discarded, an integer in
+        [10, 1e6] (default 1000).
     t_max : float, optional
-        The longest run, > 0 (default as above).
+        The longest run (of each continuation, with ``"auto"``), > 0 (default as above).
 
     Returns
     -------
     StickSlipExtrema
         The means with their standard errors, the period and the status
-        (``'transient'`` when the cycles still drift).
+        (``'transient'`` when the cycles still drift; with ``"auto"``, after
+        ``max_discard`` discarded shocks).  ``result`` is the run (with ``"auto"``, its
+        last continuation); ``shocks`` the shocks averaged over, their times counted from
+        the start of the whole run.
 
     Raises
     ------
@@ -866,29 +898,57 @@ def stick_slip_extrema_nblock(
     _check_model(model)
     v = _check_float("velocity", velocity, low=0.0, strict=True)
     n_cycles = _check_int("n_cycles", n_cycles, 2, 10**6)
-    n_discard = _check_int("n_discard", n_discard, 0, 10**6)
-    total = n_discard + n_cycles
-    if t_max is None:
-        t_max = (total + 1) * 2.0 * model.f_th / (model.k0 * v)
-    t_max = _check_float("t_max", t_max, low=0.0, strict=True)
-    if record_every is None:
-        record_every = t_max / 2000.0
-    res = simulate_nblock(
-        model, v, n_blocks, t_max=t_max, seed=seed, record_every=record_every, initial=initial,
-        phases=phases, shock_fraction=shock_fraction, stop_after_shocks=total, max_jumps=max_jumps,
-    )
-    used = res.shocks.iloc[n_discard:]
+    auto = isinstance(n_discard, str)
+    if auto and n_discard != "auto":
+        raise ValueError(f"n_discard must be an integer in [0, 1000000] or 'auto', got {n_discard!r}")
+    if auto:
+        max_discard = _check_int("max_discard", max_discard, AUTO_MIN_DISCARD, 10**6)
+        first = max(AUTO_MIN_DISCARD, n_cycles) + n_cycles
+    else:
+        n_discard = _check_int("n_discard", n_discard, 0, 10**6)
+        first = n_discard + n_cycles
+    if t_max is not None:
+        t_max = _check_float("t_max", t_max, low=0.0, strict=True)
+    seed = _check_int("seed", seed, 0, 2**64 - 1)
+
+    def run(state, shocks: int, segment: int) -> NBlockResult:
+        span = (shocks + 1) * 2.0 * model.f_th / (model.k0 * v) if t_max is None else t_max
+        return simulate_nblock(
+            model, v, n_blocks, t_max=span, seed=_continued_seed(seed, segment),
+            record_every=span / 2000.0 if record_every is None else record_every, initial=state, phases=phases,
+            shock_fraction=shock_fraction, stop_after_shocks=shocks, max_jumps=max_jumps,
+        )
+
+    res = run(initial, first, 0)
+    frames, offset, segment, wall = [res.shocks], 0.0, 0, res.wall_time
+    while auto:
+        shocks = pd.concat(frames, ignore_index=True)
+        window = shocks.iloc[-2 * n_cycles:]  # (the cycles to use and as many before them)
+        # (a run that ended short of its shocks, by t_max or max_jumps, is not continued)
+        done = (len(shocks) < first + segment * n_cycles
+                or not any(_drifts(window[c].to_numpy()) for c in ("sigma_before", "sigma_after")))
+        if done or len(shocks) - n_cycles >= max_discard:
+            break
+        offset += res.final_state.t
+        segment += 1
+        res = run(res.final_state, n_cycles, segment)
+        wall += res.wall_time
+        frames.append(res.shocks.assign(t=res.shocks["t"] + offset))
+    shocks = pd.concat(frames, ignore_index=True)
+    if auto:
+        n_discard = max(len(shocks) - n_cycles, AUTO_MIN_DISCARD)
+    used = shocks.iloc[n_discard:]
     nan = float("nan")
     if len(used) < 2:
-        msg = f"only {len(res.shocks)} global shocks by t = {res.final_state.t:g} ({res.status}): no stick-slip cycle"
+        msg = f"only {len(shocks)} global shocks by t = {offset + res.final_state.t:g} ({res.status}): no stick-slip cycle"
         logger.info("stick_slip_extrema_nblock(V=%g): %s", v, msg)
         return StickSlipExtrema(nan, nan, nan, nan, nan, nan, int(len(used)), "steady", "no_cycles", msg,
-                                v, res.n_blocks, res.wall_time, res.shocks, res)
+                                v, res.n_blocks, wall, shocks, res)
     before = used["sigma_before"].to_numpy()
     after = used["sigma_after"].to_numpy()
     periods = np.diff(used["t"].to_numpy())
     status = "ok" if len(used) == n_cycles else "fewer_cycles"
-    msg = f"{len(used)} cycles after {n_discard} discarded shocks"
+    msg = f"{len(used)} cycles after {n_discard} discarded shocks{' (chosen by the drift test)' if auto else ''}"
     if status != "ok":
         logger.warning("stick_slip_extrema_nblock(V=%g): only %s", v, msg)
     else:
@@ -897,7 +957,8 @@ def stick_slip_extrema_nblock(
             status = "transient"
             half = len(before) // 2
             msg += (f"; {' and '.join(drift)} still drift (sigma_max {before[:half].mean():.6g} over the first "
-                    f"half, {before[half:].mean():.6g} over the second): raise n_discard")
+                    f"half, {before[half:].mean():.6g} over the second): "
+                    + ("raise max_discard" if auto else "raise n_discard"))
             logger.warning("stick_slip_extrema_nblock(V=%g): %s", v, msg)
     return StickSlipExtrema(
         sigma_max=float(before.mean()),
@@ -912,7 +973,7 @@ def stick_slip_extrema_nblock(
         message=msg,
         velocity=v,
         n_blocks=res.n_blocks,
-        wall_time=res.wall_time,
+        wall_time=wall,
         shocks=used.reset_index(drop=True),
         result=res,
     )

@@ -429,3 +429,30 @@ def test_stick_slip_extrema_flag_a_transient():
     assert seq[0] - seq[-1] > 0.01
     # the standard error is not the naive one of a strongly correlated sequence
     assert out.sigma_max_stderr > seq.std(ddof=1) / np.sqrt(seq.size)
+
+
+@pytest.mark.slow
+def test_the_default_discard_runs_until_the_cycles_stop_drifting():
+    # k0 = 0.01, V = 1 (0.125 V^c), N = 2e4: from the relaxed start ten discarded shocks
+    # leave sigma_max drifting (0.96328 over the first four cycles, 0.96230 over the next
+    # four), which the status says; the default discard goes on until the last sixteen
+    # cycles pass the drift test
+    model = nb.Model(k0=0.01)
+    fixed = nb.stick_slip_extrema_nblock(model, 1.0, 20000, n_cycles=8, n_discard=10)
+    assert fixed.status == "transient"
+    auto = nb.stick_slip_extrema_nblock(model, 1.0, 20000, n_cycles=8)
+    assert auto.status == "ok", auto.message
+    discarded = int(auto.message.split(" after ")[1].split()[0])
+    assert discarded > 10
+    assert len(auto.shocks) == 8
+    # the continuations' shock times follow on from the run before
+    assert auto.shocks["t"].is_monotonic_increasing
+    assert auto.period == pytest.approx(float(np.diff(auto.shocks["t"]).mean()))
+    assert abs(auto.period - fixed.period) < 5.0 * math.hypot(auto.period_stderr, fixed.period_stderr)
+
+
+def test_n_discard_auto_is_checked():
+    with pytest.raises(ValueError, match="n_discard must be an integer in \\[0, 1000000\\] or 'auto'"):
+        nb.stick_slip_extrema_nblock(MODEL, 1.0, 100, n_discard="many")
+    with pytest.raises(ValueError, match="max_discard"):
+        nb.stick_slip_extrema_nblock(MODEL, 1.0, 100, max_discard=3)
