@@ -76,6 +76,10 @@ def test_dc_b_with_micros_own_slope(rep):
 
 
 def test_dc_b_one_for_all_k0_is_the_least_squares_root(rep):
+    check_dc_b_least_squares(rep)
+
+
+def check_dc_b_least_squares(rep):
     """Dc_vc minimises sum_k0 (ln V^c_RS(k0 D_c) - ln V^c_micro)^2: here the root of its
     derivative, d ln V^c_RS / d ln D_c = K/V dV/dK with dV/dK = (V + B)^2 / (A - 2K(V + B)),
     between the smallest per-k0 D_c and the D_c where the stiffest k0 loses its V^c."""
@@ -139,11 +143,15 @@ def test_dc_a_residual_is_reproduced_by_the_independent_rs_cycle(rep):
 
 
 def test_dc_a_is_the_minimum_and_its_intervals_are_worse(rep):
+    check_dc_a_minimum(rep)
+
+
+def check_dc_a_minimum(rep):
     """The residual recomputed here is least at the fitted D_c: a parabola through D_c e^-+0.01
     puts the minimum within 2e-3 of it in ln D_c (the fit's tolerance is 1e-4; a D_c 5 % off gives
     0.05); the profile interval's ends sit on the level RSS_min (1 + 1/(n - 1)) and D_c -+ its
     bootstrap error is worse on both sides (on the stated side only when the interval is
-    one-sided)."""
+    one-sided).  Also the check of test_compare_fault_injection.py."""
     v = rep.values
     Dc, n = v["Dc"], len(rep["dc_points"])
     rss0 = _rss(rep, Dc)

@@ -61,10 +61,21 @@ def test_stress_jumps_are_the_shock_drops(slide_hold_slide_run):
     # hbar by shift * eps, so the drop is k0 eps shift (to 9.2e-4 measured: the jumps of the
     # step that carries the shock); the drops are 0.063 to 0.089, a wrong k0 or eps factor
     # or a shock that is not the stress drop breaks the identity by their size
-    shocks = slide_hold_slide_run.shocks
+    check_shock_drops(slide_hold_slide_run, k0=0.1, eps=FAST.eps)
+
+
+def check_shock_drops(run, k0: float, eps: float) -> None:
+    """Each global shock's stress drop is k0 eps times the bins it shifted the density by, to
+    1.5e-3, and the median shock to 2e-5 (measured: 3.5e-6 to 3.6e-6 at four of the six shocks
+    here, 1.4e-4 and 9.2e-4 at the two whose step carries other jumps too).  Also the check of
+    tests/micro/test_micro_fault_injection.py: a k0 1e-3 off in the kernels is caught by the
+    median (its drops are 6e-5 to 9e-5 off), 2 % by the largest."""
+    shocks = run.shocks
     drop = shocks.sigma_before - shocks.sigma_after
     assert drop.min() > 0.05 and np.all(shocks["shift"] > 0.0)
-    assert np.abs(drop - 0.1 * FAST.eps * shocks["shift"]).max() < 1.5e-3
+    error = np.abs(drop - k0 * eps * shocks["shift"])
+    assert error.max() < 1.5e-3
+    assert np.median(error) < 2e-5
 
 
 @pytest.mark.parametrize("V", [0.1, 10.0])

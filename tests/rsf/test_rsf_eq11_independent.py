@@ -29,6 +29,12 @@ SEQUENCE = {("stick", "slip"): ("stick->slip", "slip->stick"),
     (0.1, 1.1, 0.09, 0.0075, 0.07, 0.89),           # steady
 ])
 def test_limit_cycle_against_the_independent_eq11_cycle(k0, V, Dc, A, B, mu_inf):
+    check_limit_cycle(k0, V, Dc, A, B, mu_inf)
+
+
+def check_limit_cycle(k0, V, Dc, A, B, mu_inf):
+    """rsf.limit_cycle at TIGHT against eq11_cycle: the regime, the phase sequence, the
+    extrema and the amplitude to 1e-11 (also the check of tests/rsf/test_rsf_fault_injection.py)."""
     model = rsf.SpringSlider(rsf.HyperbolicLaw(A=A, B=B, mu_inf=mu_inf), k0=k0, Dc=Dc)
     ref = eq11_cycle(A=A, B=B, mu_inf=mu_inf, k0=k0, Dc=Dc, V=V)
     got = rsf.limit_cycle(model, V, options=TIGHT)
@@ -37,3 +43,4 @@ def test_limit_cycle_against_the_independent_eq11_cycle(k0, V, Dc, A, B, mu_inf)
         assert got.sequence == SEQUENCE[ref["sequence"]]
     assert got.sigma_max == pytest.approx(ref["sigma_max"], abs=1e-11)
     assert got.sigma_min == pytest.approx(ref["sigma_min"], abs=1e-11)
+    assert got.amplitude == pytest.approx(ref["sigma_max"] - ref["sigma_min"], abs=2e-11)
