@@ -11,18 +11,17 @@ is an error.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import logging
 import math
 import re
 import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import pandas as pd
 
+from . import _outputs
 from .api import critical_velocity, simulate, sweep
 from .methods import FP, RETIRED, Auto, Cohort, Convergence, default_eps
 from .params import Deterministic, Exponential, Model
@@ -56,54 +55,23 @@ def _floats(text: str, name: str, low: float, high: float) -> list[float]:
     return values
 
 
-def _check_out(path: str, option: str = "--out") -> Path:
-    """The CSV can be written there: fail now, not after the computation.  A symbolic link
-    is checked (and later written) at its target."""
-    if not path.strip():
-        raise ValueError(f"{option} must name a CSV file, got {path!r}")
-    out = Path(path)
-    if out.is_dir():
-        raise ValueError(f"{option} {path!r} is a directory; give a file name")
-    parent = Path(os.path.realpath(path)).parent
-    if not parent.is_dir():
-        raise ValueError(f"{option} {path!r}: the directory {str(parent)!r} does not exist")
-    try:
-        fd, probe = tempfile.mkstemp(dir=parent, prefix=f".{out.name}.", suffix=".tmp")
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise ValueError(f"{option} {path!r}: cannot write in {str(parent)!r} ({exc.strerror})") from None
-    return out
+def _check_out(path: str, option: str = "--out") -> _outputs.Target:
+    """Where the CSV goes, checked now, not after the computation (:mod:`micro._outputs`:
+    ``-`` is standard output; a symbolic link is checked, and later written, at its target)."""
+    return _outputs.target(path, option, what="CSV file")
 
 
-def _write_csv(frame: pd.DataFrame, out: Path) -> None:
-    """Atomically: a temporary file beside ``out``, renamed over it once complete, and left
-    as a plain write would leave it: a new file gets ``0o666 & ~umask`` (mkstemp creates
-    0600), an existing file keeps its mode, and a symbolic link stays a link (its target
-    gets the data).
-
-    The same logic is ``rsf.results.write_atomically`` (which compare uses); micro keeps
-    this copy because micro and rsf are independent packages and neither imports the other.
-    """
-    import stat
-
-    target = Path(os.path.realpath(out))
-    try:
-        mode = stat.S_IMODE(os.stat(target).st_mode)
-    except FileNotFoundError:
-        mask = os.umask(0o022)      # read the umask (only possible by setting it) ...
-        os.umask(mask)              # ... and put it back at once
-        mode = 0o666 & ~mask
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", newline="") as f:
+def _write_csv(frame: pd.DataFrame, out: _outputs.Target | str | os.PathLike) -> None:
+    """By the policy of every output (:mod:`micro._outputs`, the same module as rsf's): a
+    regular file atomically (a temporary file beside it, renamed over it once complete; a
+    new file gets ``0o666 & ~umask``, an existing one keeps its owner and mode, a symbolic
+    link stays a link and its target gets the data), standard output (``-``), a device or
+    a FIFO in place."""
+    def fill(tmp: Path) -> None:
+        with open(tmp, "w", newline="") as f:
             frame.to_csv(f, index=False)
-        os.chmod(tmp, mode)
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+
+    _outputs.write(out, fill)
 
 
 def _bounded(value: float, name: str, low: float, high: float, *, open_low: bool = False) -> float:
@@ -245,7 +213,7 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--no-growth-rate", dest="growth_rate", action="store_false",
                     help="skip the growth rate of the unstable mode (about 0.03 s per unstable V)")
     st.add_argument("--out", required=True,
-                    help="output CSV: k0,k1,k2,zbar,V,sigma,branching_ratio,stable,growth_rate,sigma_error,converged,"
+                    help="output CSV (- for standard output): k0,k1,k2,zbar,V,sigma,branching_ratio,stable,growth_rate,sigma_error,converged,"
                          "method (chain, fixed point or no dashpot)")
 
     s = sub.add_parser("sweep", help="stationary state for each drive velocity: one CSV row per V")
@@ -256,7 +224,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "(seconds per row at every k0; the Fokker-Planck equation only for non-exponential jumps); "
                         "cohort: the same, never the Fokker-Planck state; fp: time-step every row (minutes)")
     s.add_argument("--out", required=True,
-                   help="output CSV, written after every row: k0,k1,k2,zbar,V,method,regime,sigma_max,sigma_min,"
+                   help="output CSV (- for standard output), a file rewritten after every row: k0,k1,k2,zbar,V,method,regime,sigma_max,sigma_min,"
                         "sigma_mean,...,sigma_stderr,discretisation_error,...")
 
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
@@ -273,7 +241,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="decide oscillations smaller than 2 eps by their size and global shocks instead of "
                         "rerunning them at eps/2 (several times faster near Vc, but Vc then carries the "
                         "grid's error: k0=0.1, eps=0.016: 0.90 against 0.73)")
-    c.add_argument("--out", required=True, help="output CSV: k0,k1,k2,zbar,Vc,V_low,V_high,status,message,method")
+    c.add_argument("--out", required=True, help="output CSV (- for standard output): k0,k1,k2,zbar,Vc,V_low,V_high,status,message,method")
 
     r = sub.add_parser("run", help="stress time series of one protocol: columns t,w,sigma")
     _model_options(r)
@@ -283,7 +251,7 @@ def build_parser() -> argparse.ArgumentParser:
     drive.add_argument("--shs", nargs=4, type=float, metavar=("V", "SLIDE", "HOLD", "RESUME"),
                        help="slide-hold-slide: drive at V for SLIDE, hold for HOLD, resume for RESUME")
     r.add_argument("--duration", type=float, help="run length for --V, in (0, 1e8]")
-    r.add_argument("--out", required=True, help="output CSV: t,w,sigma (plus window min/max/mean)")
+    r.add_argument("--out", required=True, help="output CSV (- for standard output): t,w,sigma (plus window min/max/mean)")
     return p
 
 
@@ -366,8 +334,10 @@ def _run(args) -> int:
         method = "fp" if args.method == "fp" else cohort if args.method == "cohort" else Auto(cohort=cohort)
 
         def row_done(frame: pd.DataFrame) -> None:
-            # the CSV holds every row computed so far: a later row that fails, or a kill, loses nothing
-            _write_csv(frame, out)
+            # a file holds every row computed so far: a later row that fails, or a kill, loses
+            # nothing (standard output, a device or a FIFO take the rows once, at the end)
+            if out.replaceable:
+                _write_csv(frame, out)
             last = frame.iloc[-1]
             print(f"{_progress(len(frame), len(velocities), time.perf_counter() - start)} V={last.V:g}: "
                   f"{last.regime} ({last.method}), sigma_max={last.sigma_max:.6f}, sigma_min={last.sigma_min:.6f}"
@@ -375,6 +345,8 @@ def _run(args) -> int:
 
         frame = sweep(models[0], velocities, method=method, numerics=numerics, convergence=convergence,
                       on_row=row_done)
+        if not out.replaceable:
+            _write_csv(frame, out)
         print(f"wrote {len(frame)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0 if frame.converged.all() else 3
     if args.command == "critical":

@@ -18,7 +18,6 @@ import math
 import os
 import re
 import sys
-import tempfile
 from pathlib import Path
 from typing import Sequence
 
@@ -29,7 +28,7 @@ from .laws import (PAPER_A, PAPER_B, PAPER_DC, PAPER_K0_MAX, HyperbolicLaw, LogL
                    ViscoelasticLaw)
 from ._validation import positive
 from .params import T_END_MAX, Protocol, SolverOptions, SpringSlider
-from .results import write_atomically
+from . import _outputs
 from .state_laws import NagataLaw, SecondState
 from .solver import simulate, sweep
 
@@ -61,35 +60,16 @@ def _floats(text: str) -> list[float]:
     return values
 
 
-def _check_out(path: str | None, option: str) -> None:
-    """The CSV can be written there (``None`` or ``-``: standard output): fail before computing.
-    A symbolic link is checked (and later written) at its target."""
-    if path is None or path == "-":
-        return
-    if not path.strip():
-        raise ValueError(f"{option} must name a CSV file (or - for standard output), got {path!r}")
-    out = Path(os.path.realpath(path))
-    if out.is_dir():
-        raise ValueError(f"{option} {path!r} is a directory; give a file name")
-    if not out.parent.is_dir():
-        raise ValueError(f"{option} {path!r}: the directory {str(out.parent)!r} does not exist")
-    try:
-        fd, probe = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise ValueError(f"{option} {path!r}: cannot write in {str(out.parent)!r} ({exc.strerror})") from None
-
-
-def _check_distinct(out: str | None, events: str | None) -> None:
-    """``--out`` and ``--events`` must not name one file (the events would overwrite the
-    series): compared after resolving links and relative paths."""
-    if out is None or events is None:
-        return
-    same = out == events if "-" in (out, events) else os.path.realpath(out) == os.path.realpath(events)
-    if same:
-        raise ValueError(f"--out and --events name the same file ({out!r} and {events!r}); "
-                         "give two different files")
+def _outputs_of(args: argparse.Namespace) -> tuple[_outputs.Target, _outputs.Target | None]:
+    """Where ``--out`` (default ``-``: standard output) and ``--events`` go, checked before
+    anything is computed (:mod:`rsf._outputs`): neither is the other, nor an input of the
+    call (``--table``, ``--history``), compared by device and inode."""
+    out = _outputs.target("-" if args.out is None else args.out, "--out", what="CSV file")
+    events = getattr(args, "events", None)
+    events = None if events is None else _outputs.target(events, "--events", what="CSV file")
+    _outputs.check_distinct([out, events], {"--table": getattr(args, "table", None),
+                                            "--history": getattr(args, "history", None)})
+    return out, events
 
 
 def _check_magnitudes(args: argparse.Namespace) -> None:
@@ -311,20 +291,21 @@ def _options(args: argparse.Namespace) -> SolverOptions:
                              v_max=args.v_max, max_rhs_evals=args.max_rhs_evals)
 
 
-def _write(frame, out: str | None, note: str = "") -> None:
-    """To standard output, or atomically (:func:`rsf.results.write_atomically`: the umask,
-    an existing file's mode and a symbolic link are respected).  The count of rows goes to
-    standard error, so that standard output carries nothing but data."""
-    if out is None or out == "-":
-        frame.to_csv(sys.stdout, index=False)
-        return
+def _write(frame, out: _outputs.Target | str | None, note: str = "") -> None:
+    """By the policy of every output (:mod:`rsf._outputs`): a regular file atomically (its
+    owner and mode kept, a symbolic link written through), standard output (``-``, None),
+    a device or a FIFO in place.  The count of rows goes to standard error, so that
+    standard output carries nothing but data."""
+    if not isinstance(out, _outputs.Target):
+        out = _outputs.target("-" if out is None else out, "--out", what="CSV file", probe=False)
 
     def fill(tmp: Path) -> None:
         with open(tmp, "w", newline="") as f:
             frame.to_csv(f, index=False)
 
-    write_atomically(out, fill)
-    print(f"wrote {len(frame)} rows to {out}{note}", file=sys.stderr)
+    _outputs.write(out, fill)
+    if out.given != "-":
+        print(f"wrote {len(frame)} rows to {out}{note}", file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -371,8 +352,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "(t from 0, strictly increasing), linear between the samples (a > 0)")
     pr.add_argument("--t-end", type=float, required=True,
                     help=f"end time, in (0, {T_END_MAX:g}] (the bound of rsf.simulate's t_end)")
-    pr.add_argument("--out", required=True, help="output CSV for the time series")
-    pr.add_argument("--events", default=None, help="output CSV for the events t, kind, sigma, theta, x")
+    pr.add_argument("--out", required=True, help="output CSV for the time series (- for standard output)")
+    pr.add_argument("--events", default=None, help="output CSV for the events t, kind, sigma, theta, x (- for standard output)")
     pr.add_argument("--t-eval", type=_floats, default=None,
                     help="output times t1,t2,... (strictly increasing, in [0, t-end]): samples "
                          "exactly there instead of at every integrator step")
@@ -549,9 +530,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         # everything is checked before anything is computed
-        _check_out(args.out, "--out")
-        _check_out(getattr(args, "events", None), "--events")
-        _check_distinct(args.out, getattr(args, "events", None))
+        out, events = _outputs_of(args)
         _check_magnitudes(args)
         _check_law_options(args)
         if args.command == "critical":
@@ -562,7 +541,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 if r.status != "unstable band":
                     print(f"k0={r.k0:g}: {r.status} (Vc = {r.Vc:g})", file=sys.stderr)
             frame = pd.concat([r.to_frame() for r in results], ignore_index=True)
-            _write(frame, args.out)
+            _write(frame, out)
             return 0
         model = _model(args, args.k0)
         options = _options(args)
@@ -577,7 +556,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             if isinstance(model.law, TabulatedLaw):
                 model.law.check_velocities(velocities, "--V")
             result = sweep(model, velocities, options=options, progress=args.verbose)
-            _write(result.to_frame(), args.out)
+            _write(result.to_frame(), out)
             if not result.all_converged:
                 print(f"warning: {result.message}", file=sys.stderr)
                 return 3
@@ -594,9 +573,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         traj = traj.thinned(out_dt)
         note = "" if traj.t.size == steps else (f" (of {steps} integrator steps: one row per --out-dt = "
                                                 f"{out_dt:g} between events; --out-dt 0 writes them all)")
-        _write(traj.to_frame(), args.out, note)
-        if args.events:
-            _write(traj.events_frame(), args.events)
+        _write(traj.to_frame(), out, note)
+        if events is not None:
+            _write(traj.events_frame(), events)
         if not traj.success:
             print(f"warning: {traj.message}", file=sys.stderr)
             return 3

@@ -6,17 +6,16 @@ failures.  A limit-cycle search never ends silently unconverged: it reports
 """
 from __future__ import annotations
 
-import contextlib
 import math
 import os
-import stat
-import tempfile
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 import pandas as pd
+
+from . import _outputs
 
 __all__ = [
     "STATUS_MESSAGES",
@@ -29,58 +28,27 @@ __all__ = [
 ]
 
 
-def _umask() -> int:
-    """The process's umask (read from /proc where it can be, since ``os.umask`` can only be
-    read by setting it)."""
-    with contextlib.suppress(OSError, ValueError):
-        with open("/proc/self/status", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 def write_atomically(path: str | os.PathLike, write: Callable[[Path], None], *,
-                     fsync: bool = False, suffix: str | None = None) -> Path:
-    """Write a file the way ``open(path, 'w')`` would leave it, but atomically.
+                     fsync: bool = False, suffix: str | None = None) -> Path | None:
+    """Write a file the way ``open(path, 'w')`` would leave it, but without destroying
+    anything (the policy of every output: :mod:`rsf._outputs`).
 
-    ``write(tmp)`` fills a temporary file beside the target, which is then renamed over it,
-    so that a reader (or a crash) sees either the old file or the whole new one.  The file
-    ends up as a plain write would leave it: a new file gets ``0o666 & ~umask`` (mkstemp
-    creates 0600), an existing file keeps its mode, and a symbolic link stays a link: the
-    data go to the file it points to.  ``fsync``: flush the data to disk before the rename.
-    ``suffix``: of the temporary file (default the target's, so that a writer that picks a
-    format from the name picks the target's).  Returns the path written (the link's target for a link).
+    ``write(tmp)`` fills a temporary file.  A regular file (or a new one) is then replaced
+    by it atomically, so that a reader (or a crash) sees either the old file or the whole
+    new one: a new file gets ``0o666 & ~umask`` (mkstemp creates 0600), an existing file
+    keeps its owner and mode, and a symbolic link stays a link: the data go to the file it
+    points to.  A device, a FIFO or this process's standard output is written in place.
+    A read-only file, or one whose owner could not be kept, is refused (ValueError).
+    ``fsync``: flush the data to disk before the rename.  ``suffix``: of the temporary
+    file (default the target's, so that a writer that picks a format from the name picks
+    the target's).  Returns the path written (the link's target for a link; None for
+    standard output).
 
-    rsf's command line and compare write every output through this function.  micro keeps
-    its own copy (``micro.cli._write_csv``): micro and rsf are independent packages, neither
-    imports the other.
+    rsf's command line and compare write every output through this policy; micro has the
+    same module (``micro/_outputs.py``, identical: micro and rsf are independent packages,
+    neither imports the other).
     """
-    target = Path(os.path.realpath(os.fspath(path)))
-    try:
-        mode = stat.S_IMODE(os.stat(target).st_mode)
-    except FileNotFoundError:
-        mode = 0o666 & ~_umask()
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.",
-                               suffix=target.suffix if suffix is None else suffix)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.chmod(tmp, mode)
-        if fsync:
-            fd = os.open(tmp, os.O_RDONLY)
-            try:
-                os.fsync(fd)
-            finally:
-                os.close(fd)
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    return target
+    return _outputs.write(path, write, fsync=fsync, suffix=suffix)
 
 
 class Status:
