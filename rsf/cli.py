@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import logging
 import math
 import os
@@ -29,6 +30,7 @@ from .laws import (PAPER_A, PAPER_B, PAPER_DC, PAPER_K0_MAX, HyperbolicLaw, LogL
 from ._validation import positive
 from .params import T_END_MAX, Protocol, SolverOptions, SpringSlider
 from . import _outputs
+from .results import STATUS_MESSAGES, Status
 from .state_laws import NagataLaw, SecondState
 from .solver import simulate, sweep
 
@@ -194,6 +196,11 @@ _MODEL_NAMES = {"k0": "--k0", "Dc": "--Dc", "a": "--a", "eta_rad": "--eta-rad", 
                 "second_state": "--b2 and --Dc2"}
 _SOLVER_NAMES = {"rtol": "--rtol", "atol": "--atol", "cycle_rtol": "--cycle-rtol",
                  "max_cycles": "--max-cycles", "v_max": "--v-max", "max_rhs_evals": "--max-rhs-evals"}
+
+
+def _resolve_names(velocity: str) -> dict[str, str]:
+    """The options behind the parameters :meth:`rsf.SpringSlider.check_resolved` names."""
+    return {"k0": "--k0", "Dc": "--Dc", "V": velocity, "A": "--A", "B": "--B", "mu_inf": "--mu-inf"}
 
 
 @contextlib.contextmanager
@@ -493,6 +500,46 @@ def _t_eval(args: argparse.Namespace) -> np.ndarray | None:
     return np.asarray(times, dtype=float)
 
 
+#: ``rsf run`` first integrates this many events: a run that ends within them is the result,
+#: else their pace tells whether --t-end fits in the event budget (SolverOptions.max_events).
+PROBE_EVENTS = 1000
+
+
+class _DropProbeStop(logging.Filter):
+    """Drops the warning of a run stopped at its event budget (the probe's)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not record.getMessage().startswith("simulate: " + STATUS_MESSAGES[Status.MAX_EVENTS])
+
+
+def _simulate_within_budget(model: SpringSlider, V, protocol, t_end: float, options: SolverOptions,
+                            t_eval):
+    """:func:`rsf.simulate`, refused before the long part of the work if ``t_end`` lies
+    beyond the event budget at the pace of the first ``PROBE_EVENTS`` events (the transient
+    from the steady state included, so that the pace is underestimated, never over)."""
+    budget = options.max_events
+    if budget <= PROBE_EVENTS:
+        return simulate(model, V, protocol=protocol, t_end=t_end, options=options, t_eval=t_eval)
+    probe_options = dataclasses.replace(options, max_events=PROBE_EVENTS)
+    quiet = _DropProbeStop()       # the probe's own stop is not the run's: not logged
+    solver_logger = logging.getLogger("rsf.solver")
+    solver_logger.addFilter(quiet)
+    try:
+        probe = simulate(model, V, protocol=protocol, t_end=t_end, options=probe_options, t_eval=t_eval)
+    finally:
+        solver_logger.removeFilter(quiet)
+    if probe.status != Status.MAX_EVENTS:
+        return probe          # the whole run (max_events plays no other part)
+    t_probe = float(probe.events[-1].t) if probe.events else float(probe.t[-1])
+    reach = t_probe * budget / PROBE_EVENTS
+    if t_end > reach:
+        raise ValueError(f"--t-end {t_end:g} is beyond the event budget: the first {PROBE_EVENTS} events "
+                         f"took t = {t_probe:.4g}, so the run would need about "
+                         f"{PROBE_EVENTS * t_end / t_probe:.3g} events, more than the {budget} allowed "
+                         f"(rsf.SolverOptions.max_events); give --t-end <= {reach:.3g}")
+    return simulate(model, V, protocol=protocol, t_end=t_end, options=options, t_eval=t_eval)
+
+
 def _driving_velocities(V, protocol: Protocol | None) -> np.ndarray:
     """The load-point velocities of a run (its nonzero ones for a protocol)."""
     if protocol is None:
@@ -555,6 +602,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 velocities = np.geomspace(vmin, vmax, int(n))
             if isinstance(model.law, TabulatedLaw):
                 model.law.check_velocities(velocities, "--V")
+            for V in velocities:     # a stick-slip double precision cannot resolve: refused now
+                model.check_resolved(float(V), _resolve_names("--V" if args.V is not None else "--V-range"))
             result = sweep(model, velocities, options=options, progress=args.verbose)
             _write(result.to_frame(), out)
             if not result.all_converged:
@@ -566,8 +615,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         _out_dt(args, 0)
         if isinstance(model.law, TabulatedLaw):
             model.law.check_velocities(_driving_velocities(V, protocol), "the driving velocity V")
-        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
-                        t_eval=t_eval)
+        for v in _driving_velocities(V, protocol):
+            model.check_resolved(float(v), _resolve_names("--V" if V is not None else "the driving velocity"))
+        traj = _simulate_within_budget(model, V, protocol, args.t_end, options, t_eval)
         steps = traj.t.size
         out_dt = _out_dt(args, steps)
         traj = traj.thinned(out_dt)

@@ -6,7 +6,8 @@ A cycle runs from one anchor to the next: a slip landing (``'slip->...'``; with 
 after 200 events, ``'slide->stick'``) for the a = 0 engine, a minimum of :math:`\sigma`
 for the a > 0 engine.  It has converged when :math:`\sigma_{max}`, :math:`\sigma_{min}`,
 the period and the amplitude of two consecutive simulated cycles with the same sequence
-of events differ by less than ``cycle_rtol`` (relative).
+of events differ by less than ``cycle_rtol`` (relative).  Two equal "cycles" of period 0
+or of no amplitude are not a limit cycle: the status is then ``DEGENERATE``.
 """
 from __future__ import annotations
 
@@ -152,6 +153,13 @@ class CycleSearch:
                 if self.relative_change <= options.cycle_rtol:
                     self.status = Status.CONVERGED
                     self.result = last
+                    if not (last.period > 0.0 and last.sigma_max > last.sigma_min):
+                        # two equal cycles, but no cycle: no time passed or no stress moved
+                        self.status = Status.DEGENERATE
+                        self.detail = (f"period {last.period:g}, sigma_max - sigma_min = "
+                                       f"{last.sigma_max - last.sigma_min:g}, sequence "
+                                       f"{' '.join(last.sequence)}: the motion is not resolved "
+                                       f"in double precision")
                     return True
         if len(cycles) > options.max_cycles:
             self.status = Status.MAX_CYCLES

@@ -212,14 +212,15 @@ class HyperbolicLaw(SteadyStateLaw):
     B : float
         Velocity scale, > 0 (paper: 0.078).
     mu_inf : float or None
-        Large-velocity friction.  ``None`` means the paper's value for the driving stiffness,
+        Large-velocity friction, finite and >= 0.  ``None`` means the paper's value for the driving stiffness,
         :math:`\mu_\infty = f^{th} - \bar z (k_0 + k_1 + k_2)/2` (:func:`paper_mu_inf`),
         resolved by :meth:`bind` (which :class:`~rsf.params.SpringSlider` calls).
 
     Raises
     ------
     ValueError
-        If ``A`` is negative, ``B`` is not a finite number > 0 or ``mu_inf`` is not finite;
+        If ``A`` is negative, ``B`` is not a finite number > 0 or ``mu_inf`` is not a finite
+        number >= 0;
         :meth:`bind` if the default ``mu_inf`` is not positive (k0 >= 19).
 
     Examples
@@ -239,7 +240,11 @@ class HyperbolicLaw(SteadyStateLaw):
         object.__setattr__(self, "A", nonnegative("A", self.A))
         object.__setattr__(self, "B", positive("B", self.B))
         if self.mu_inf is not None:
-            object.__setattr__(self, "mu_inf", finite("mu_inf", self.mu_inf))
+            mu_inf = finite("mu_inf", self.mu_inf)
+            if mu_inf < 0.0:   # Eq. (6): the friction of steady sliding at large V
+                raise ValueError(f"mu_inf must be >= 0 (the friction at large V, Eq. 6; a negative "
+                                 f"one pulls the block forward), got {mu_inf:g}")
+            object.__setattr__(self, "mu_inf", mu_inf)
 
     def bind(self, k0: float) -> HyperbolicLaw:
         """The law with the default ``mu_inf`` resolved for ``k0``.  The default, the paper's
@@ -345,6 +350,13 @@ class ViscoelasticLaw(SteadyStateLaw):
             object.__setattr__(self, "k0", nonnegative("k0", self.k0))
             if not self.mu_ref > 0.0:
                 k0_max = 2.0 * self.f_th / self.zbar - self.k1 - self.k2
+                if not k0_max > 0.0:   # no stiffness helps: blame the well spacing
+                    raise ValueError(
+                        f"zbar must be < 2 f_th / (k0 + k1 + k2) = "
+                        f"{2.0 * self.f_th / (self.k0 + self.k1 + self.k2):g} for this law (f_th - zbar "
+                        f"(k0 + k1 + k2)/2, the friction at large V, Eq. 6, must be > 0), got zbar = "
+                        f"{self.zbar:g} with f_th = {self.f_th:g}, k0 = {self.k0:g}, k1 = {self.k1:g}, "
+                        f"k2 = {self.k2:g}")
                 raise ValueError(
                     f"k0 must be < {k0_max:g} for this law (f_th - zbar (k0 + k1 + k2)/2, the friction "
                     f"at large V, must be > 0), got k0 = {self.k0:g} (friction {self.mu_ref:g})")

@@ -14,6 +14,7 @@ The model (paper, Sec. V.B; :math:`F_N = 1`, no inertia):
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 from typing import Sequence
 
@@ -31,12 +32,25 @@ from .state_laws import (
     state_law_from,
 )
 
-__all__ = ["SpringSlider", "Protocol", "InitialState", "SolverOptions", "standard_rs", "T_END_MAX"]
+__all__ = ["SpringSlider", "Protocol", "InitialState", "SolverOptions", "standard_rs", "T_END_MAX",
+           "DC_MIN", "THETA_FLOOR"]
 
 #: The longest run :func:`rsf.simulate` and ``rsf run --t-end`` accept (one bound for both).
 #: A steady slide is followed to it in a few CVODE runs; a run of stick-slip cycles that long
 #: ends at ``SolverOptions.max_events`` or ``max_rhs_evals`` with its status.
 T_END_MAX = 1e8
+
+#: The smallest state the a = 0 engine resolves, in units of Dc: a slip of a law with a
+#: finite large-velocity limit lands there (the state below it is not resolved).
+THETA_FLOOR = 1e-250
+
+#: The smallest Dc: the a = 0 engine's floor of the state, ``THETA_FLOOR * Dc``, must be a
+#: normal double (>= 2.2e-308), else a slip's length ln(theta / floor) divides by zero.
+DC_MIN = sys.float_info.min / THETA_FLOOR
+
+#: A slip's onset is resolved when the threshold lies at least this far (relative) below
+#: its plateau (see :meth:`SpringSlider.check_resolved`): two units of roundoff.
+ONSET_RESOLUTION = 2.0 * sys.float_info.epsilon
 
 
 @dataclass(frozen=True)
@@ -52,7 +66,10 @@ class SpringSlider:
     k0 : float
         Driving stiffness, > 0.
     Dc : float
-        Critical slip distance, > 0 (paper: 0.06).
+        Critical slip distance, finite and >= ``DC_MIN`` (2.2e-58: the a = 0 engine
+        resolves the state down to ``THETA_FLOOR * Dc``, which must be a normal double;
+        paper: 0.06).  How small a ``Dc`` still resolves a slip depends on the driving
+        velocity too: :meth:`check_resolved`.
     a : float or None
         Direct effect :math:`a \ge 0`.  ``None``: the law's ``a`` for a
         :class:`~rsf.laws.LogLaw` (Eq. 7), otherwise 0 (the paper's model, Eq. 11).
@@ -107,7 +124,11 @@ class SpringSlider:
                              f"TabulatedLaw, CallableLaw), got {self.law!r}")
         k0 = positive("k0", self.k0)
         object.__setattr__(self, "k0", k0)
-        object.__setattr__(self, "Dc", positive("Dc", self.Dc))
+        Dc = positive("Dc", self.Dc)
+        if Dc < DC_MIN:
+            raise ValueError(f"Dc must be >= {DC_MIN:.3g} (the state is resolved down to "
+                             f"{THETA_FLOOR:g} Dc, which must be a normal double), got {shown(self.Dc)}")
+        object.__setattr__(self, "Dc", Dc)
         object.__setattr__(self, "law", self.law.bind(k0))
         a = self.a
         if a is None:
@@ -157,6 +178,72 @@ class SpringSlider:
         if isinstance(self.law, TabulatedLaw):
             self.law.check_velocities([V])
         return float(self.law.mu_ss(V))
+
+    def check_resolved(self, V: float, names: dict[str, str] | None = None) -> None:
+        r"""Raise ValueError where the stick-slip of the a = 0 model at driving velocity
+        ``V`` cannot be resolved in double precision (else a "cycle" of period 0 with
+        :math:`\sigma_{max} = \sigma_{min}` would come out).
+
+        For a law whose threshold :math:`\phi(\theta) = \mu_{ss}(D_c/\theta)` (Eq. 11)
+        levels off at a plateau, :math:`\Delta = \sup\mu_{ss} - \mu_\infty` (``concave_sup``;
+        :math:`A/B` for Eq. 10), a slip lands near :math:`\theta = 0` and the next stick
+        lasts at most :math:`t_s = \Delta/(k_0 V)` (Eq. 12, :math:`\dot\sigma = k_0 V`), in
+        which :math:`\theta` grows at rate 1 (Eq. 8 at :math:`v = 0`).  So the next slip
+        starts at :math:`\theta_0/D_c \le \Delta/(K V)` with :math:`K = k_0 D_c`:
+
+        * ``theta0 / (THETA_FLOOR Dc)`` must be a finite double (the slip's length
+          :math:`\ln(\theta_0/\theta_{floor})`): :math:`\Delta/(K V) <` ``THETA_FLOOR`` x
+          1.8e308;
+        * Eq. (10): the slip starts at :math:`u_0 = D_c/\theta_0 \ge K V B/A`, where the
+          threshold lies :math:`A/B - A/(u_0 + B) \approx K V/B` below its plateau; relative
+          to the friction :math:`\mu_\infty + A/B` this is :math:`K V/(A + B\mu_\infty)`,
+          which must exceed ``ONSET_RESOLUTION`` (two units of roundoff), else the slip
+          cannot tell the threshold from its plateau.
+
+        Both are sufficient conditions (the worst case, a stick as long as the whole swing);
+        a case between them and the true limit that still comes out degenerate gets the
+        status ``DEGENERATE`` from the limit-cycle search, never "converged".
+
+        Nothing is checked for :math:`a > 0` (a regular ODE) or a law without a plateau.
+
+        Parameters
+        ----------
+        V : float
+            The driving velocity, > 0.
+        names : dict, optional
+            The names to give the parameters in the message (the command line's options).
+        """
+        if self.a != 0.0:
+            return
+        swing = self.law.concave_sup
+        if not (math.isfinite(swing) and swing > 0.0):
+            return
+        n = {k: k for k in ("k0", "Dc", "V", "A", "B", "mu_inf")}
+        n.update(names or {})
+        KV = self.K * V
+        law = self.law
+        ceiling = THETA_FLOOR * sys.float_info.max
+        if not swing / KV < ceiling:
+            what = (f"{n['A']}/{n['B']} = {law.A:g}/{law.B:g}" if isinstance(law, HyperbolicLaw)
+                    else "the law's friction swing")
+            raise ValueError(
+                f"{n['Dc']} = {self.Dc:g}, {n['k0']} = {self.k0:g} and {n['V']} = {V:g} with {what} = "
+                f"{swing:g} are out of range: a stick's state reaches swing / (k0 Dc V) = "
+                f"{swing / KV:.3g} times Dc, which must be < {ceiling:.3g} (double range over the "
+                f"state's floor {THETA_FLOOR:g} Dc); give a larger {n['Dc']}, {n['k0']} or {n['V']}"
+                + (f", a larger {n['B']} or a smaller {n['A']}" if isinstance(law, HyperbolicLaw) else ""))
+        if isinstance(law, HyperbolicLaw):
+            depth = KV / (law.A + law.B * abs(law.mu_inf))
+            if not depth >= ONSET_RESOLUTION:
+                need = ONSET_RESOLUTION * (law.A + law.B * abs(law.mu_inf))
+                raise ValueError(
+                    f"{n['Dc']} = {self.Dc:g} with {n['k0']} = {self.k0:g}, {n['V']} = {V:g}, "
+                    f"{n['A']} = {law.A:g}, {n['B']} = {law.B:g} and {n['mu_inf']} = {law.mu_inf:g} "
+                    f"cannot be resolved: a slip starts where the threshold lies k0 Dc V / (A + B "
+                    f"mu_inf) = {depth:.3g} (relative) below its plateau, less than double "
+                    f"precision resolves ({ONSET_RESOLUTION:.3g}); k0 Dc V must be >= {need:.3g}, "
+                    f"got {KV:.3g} (a larger {n['Dc']}, {n['k0']} or {n['V']}, a smaller {n['A']} "
+                    f"or {n['mu_inf']})")
 
     def describe(self) -> dict[str, float | str]:
         """Parameters as a flat dict (for tables)."""

@@ -74,7 +74,8 @@ class Status:
     SOLVER_FAILED : int
         -4, CVODE or a root search failed.
     DEGENERATE : int
-        -5, repeated zero-length phases at a degenerate (tangent) point.
+        -5, repeated zero-length phases at a degenerate (tangent) point, or a repeating
+        "cycle" of period 0 or of no amplitude (the motion not resolved in double precision).
     STEP_BUDGET : int
         -6, the step budget ``SolverOptions.max_rhs_evals`` ran out.
     """
@@ -86,7 +87,7 @@ class Status:
     MAX_EVENTS = -2       #: too many events
     RUNAWAY = -3          #: a slip that never arrests (unbounded weakening)
     SOLVER_FAILED = -4    #: CVODE or a root search failed
-    DEGENERATE = -5       #: repeated zero-length phases at a degenerate point
+    DEGENERATE = -5       #: zero-length phases at a degenerate point, or a period-0 "cycle"
     STEP_BUDGET = -6      #: the step budget (SolverOptions.max_rhs_evals) ran out
 
 
@@ -98,7 +99,7 @@ STATUS_MESSAGES: dict[int, str] = {
     Status.MAX_EVENTS: "too many events",
     Status.RUNAWAY: "runaway slip: the slip velocity blows up (weakening exceeds the spring)",
     Status.SOLVER_FAILED: "the integrator or a root search failed",
-    Status.DEGENERATE: "repeated zero-length phases at a degenerate (tangent) point",
+    Status.DEGENERATE: "degenerate: zero-length phases or a cycle of period 0, not a limit cycle",
     Status.STEP_BUDGET: "the step budget (max_rhs_evals) ran out",
 }
 

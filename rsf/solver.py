@@ -130,6 +130,8 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     if model.a == 0.0 and protocol.is_linear:
         raise ValueError("a sampled (linearly interpolated) load history needs a direct "
                          "effect a > 0; for a = 0 use piecewise-constant steps")
+    for v in np.unique(protocol.velocities[protocol.velocities > 0.0]):
+        model.check_resolved(float(v))
     engine = make_engine(model, protocol, options, record=True, stop_at_steady=stop_at_steady,
                          t_eval=t_eval)
     engine.start(initial)
@@ -216,7 +218,9 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
     Raises
     ------
     ValueError
-        If ``model`` is not a :class:`~rsf.params.SpringSlider` or ``V`` is not a finite
+        If ``model`` is not a :class:`~rsf.params.SpringSlider`, the model's stick-slip at
+        ``V`` cannot be resolved in double precision
+        (:meth:`~rsf.params.SpringSlider.check_resolved`), or ``V`` is not a finite
         number > 0.
 
     Examples
@@ -229,6 +233,7 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     V = positive("V", V)
+    model.check_resolved(V)
     options = options or SolverOptions()
     if model.second_state is not None and options.accelerate:
         # the cycle map has two dimensions: no one-variable extrapolation
@@ -292,7 +297,8 @@ def sweep(model: SpringSlider, velocities: Iterable[float], *, options: SolverOp
     Raises
     ------
     ValueError
-        If ``velocities`` is empty or holds a value that is not a finite number > 0, or
+        If ``velocities`` is empty or holds a value that is not a finite number > 0 or at
+        which the stick-slip cannot be resolved (checked for all before the first), or
         ``model`` is not a :class:`~rsf.params.SpringSlider`.
 
     Examples
@@ -305,6 +311,10 @@ def sweep(model: SpringSlider, velocities: Iterable[float], *, options: SolverOp
     vel = [positive(f"velocities[{i}]", v) for i, v in enumerate(velocities)]
     if not vel:
         raise ValueError("velocities must hold at least one velocity > 0")
+    if not isinstance(model, SpringSlider):
+        raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
+    for V in vel:     # every velocity before the first is computed
+        model.check_resolved(V)
     results = []
     for i, V in enumerate(vel):
         results.append(limit_cycle(model, V, initial=initial, options=options))

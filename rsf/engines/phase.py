@@ -21,13 +21,12 @@ import numpy as np
 
 from .. import _kernels, _sundials
 from .._sundials import OdeSolution
-from ..params import InitialState, Protocol, SolverOptions, SpringSlider
+from ..params import THETA_FLOOR, InitialState, Protocol, SolverOptions, SpringSlider
 from ..results import Event, Status
 from .base import TAU_CHUNK, Engine, Stop, compiled, cvode_arrays, logger, onto_time
 
 __all__ = ["PhaseEngine", "SlideConstants", "SlideEvent", "chunk_span"]
 
-THETA_FLOOR = 1e-250    # smallest theta resolved, in units of Dc (slips level off below)
 ZERO_PHASES = 20        # consecutive zero-length phases before giving up
 CHUNK_GROWTH = 30       # the runs of one slide double in length, up to 2**30 TAU_CHUNK, so
                         # that a long steady slide takes tens of runs, not millions (the a > 0
