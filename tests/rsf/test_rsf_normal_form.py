@@ -1,4 +1,4 @@
-"""The normal forms of RS's transition at V^c (rsf.normal_form; docs/reference/rsf.md §19):
+"""The normal forms of RS's transition at V^c (rsf.normal_form; docs/reference/rsf.md §15):
 the first Lyapunov coefficient against closed forms and against rsf's own limit cycles,
 the a = 0 stick-slip reduction against rsf.limit_cycle, and the one test of the transition."""
 from __future__ import annotations
