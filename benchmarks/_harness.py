@@ -1,4 +1,4 @@
-"""The harness every benchmark script uses: timing with the compile time apart, writing CSV
+"""The harness every benchmark script and every study (``studies/``) uses: timing with the compile time apart, writing CSV
 files and figures, and the pieces the micro scripts share.
 
 Timing
@@ -21,8 +21,9 @@ The micro scripts
     ``capped_t_max``: a Fokker-Planck run's simulated time that fits a wall-time budget.
 
 Scripts import it as ``from _harness import ...``: run as ``python benchmarks/NAME.py``,
-the script's folder is first on ``sys.path``.  The index of the scripts is
-``benchmarks/README.md``.
+the script's folder is first on ``sys.path``.  Studies, run as ``python -m studies NAME``
+from the repository's top, import it as ``from benchmarks._harness import ...``.  The
+indexes are ``benchmarks/README.md`` and ``studies/README.md``.
 """
 from __future__ import annotations
 

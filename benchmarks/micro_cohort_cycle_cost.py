@@ -15,9 +15,10 @@ import argparse
 import numba
 
 import micro
-# private: the public cycle_cohorts runs a whole fixed-point iteration; timing one cycle
-# at a time needs the cycle state (_start) and the single cycle (_one_cycle) it is made of
-from micro.cohort import _one_cycle, _start, cycle_cohorts
+# the public cycle_cohorts runs a whole fixed-point iteration; timing one cycle at a time
+# needs the cycle state (start_state) and the single cycle (one_cycle): hooks for studies
+from micro.cohort import cycle_cohorts
+from micro.study_hooks import one_cycle, start_state
 
 from _harness import Stopwatch, warm_up
 
@@ -33,11 +34,11 @@ def main() -> None:
     warm_up(cycle_cohorts, model, V, tol=1e-2, max_iter=4)
     for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
         numba.set_num_threads(threads)
-        st = _start(model, V, model.kappa * model.zbar / 20.0, None)
+        st = start_state(model, V, model.kappa * model.zbar / 20.0, None)
         total = 0.0
         for i in range(args.cycles):
             with Stopwatch() as sw:
-                out = _one_cycle(st, 0.004)
+                out = one_cycle(st, 0.004)
             total += sw.seconds
         print(f"{threads} thread(s): {args.cycles} cycles in {total:.2f} s, the last with {st.pool} cells "
               f"and {st.n} cohorts; sigma_max of the last {out['sigma_max']:.10f}", flush=True)

@@ -3,7 +3,7 @@
 Point: k0 = 1e-3, V = 174.75 (Fig. 10's point, 1.5 times the RS V^c; Fig. 4 parameters),
 steady sliding.  Reference: the large-V law ``micro.sigma_fast_limit`` (its neglected
 O(V^-2) term is ~3e-8 here).  The Fokker-Planck rows are those of
-benchmarks/results/micro_fp_eps_convergence.csv (run micro_fp_eps_convergence.py for k0 = 0.001
+benchmarks/results/micro_fp_eps_convergence.csv (run `python -m studies micro_fp_eps_convergence` for k0 = 0.001
 first).  The N-block solver is run here for growing N; near V^c its finite-N system
 slips in global shocks, so its error is a finite-size bias that falls slowly with N.
 Its error and wall time are fitted as powers of N, and the wall time it would need to

@@ -29,11 +29,12 @@ import numpy as np
 import pandas as pd
 
 import micro
-# private: the grid table solves the chain on a fixed grid of n nodes (_Grid, _Chain, with
-# the quadrature _quadrature and the map's width _map_width), which steady_sliding chooses
+# the grid table solves the chain on a fixed grid of n nodes (the hooks for studies
+# chain_grid, chain_on_grid, with quadrature and map_width), which steady_sliding chooses
 # itself; critical_velocity_renewal (micro.renewal's __all__) takes a tolerance that
 # critical_velocity does not pass on
 from micro import renewal as R
+from micro import study_hooks as H
 
 from _harness import K0, RESULTS, median_time, timed, warm_up, write_csv
 
@@ -45,13 +46,13 @@ def grid_table() -> pd.DataFrame:
     cases = [(0.1, 0.1, 0.9, V) for V in (0.05, 0.9, 20.0, 1e4)] + [(1e-3, 0.0, 1.0, 100.0), (1e-4, 0.0, 1.0, 10.0)]
     for k0, k1, k2, V in cases:
         model = micro.Model(k0=k0, k1=k1, k2=k2)
-        quad = R._quadrature(model, V)
-        width = R._map_width(model)
-        ref = R._Chain.solve(model, V, quad, R._Grid.build(160, 0.0, width))
+        quad = H.quadrature(model, V)
+        width = H.map_width(model)
+        ref = H.chain_on_grid(model, V, quad, H.chain_grid(160, width))
         for n in (8, 12, 16, 24, 32, 48, 64, 96):
-            grid = R._Grid.build(n, 0.0, width)
-            chain = R._Chain.solve(model, V, quad, grid)
-            wall = median_time(lambda: R._Chain.solve(model, V, quad, grid))
+            grid = H.chain_grid(n, width)
+            chain = H.chain_on_grid(model, V, quad, grid)
+            wall = median_time(lambda: H.chain_on_grid(model, V, quad, grid))
             rows.append(dict(k0=k0, k1=k1, k2=k2, V=V, n=n, n_z=quad.z.size, wall_ms=1e3 * wall,
                              sigma_error=abs(chain.sigma - ref.sigma),
                              b_error=abs(chain.branching_ratio - ref.branching_ratio),
@@ -66,8 +67,8 @@ def default_table() -> pd.DataFrame:
         Vc = micro.critical_velocity(model).Vc
         for V in (0.5 * Vc, 1.5 * Vc, 10 * Vc, 1e4):
             res = micro.steady_sliding(model, V, growth_rate=False)
-            quad = R._quadrature(model, V)
-            ref = R._Chain.solve(model, V, quad, R._Grid.build(160, 0.0, R._map_width(model)))
+            quad = H.quadrature(model, V)
+            ref = H.chain_on_grid(model, V, quad, H.chain_grid(160, H.map_width(model)))
             wall = median_time(lambda: micro.steady_sliding(model, V, growth_rate=False))
             rows.append(dict(k0=k0, V=V, n=int(res.n_nodes), wall_ms=1e3 * wall, sigma=float(res.sigma),
                              sigma_error=abs(float(res.sigma) - ref.sigma), estimate=float(res.sigma_error),
@@ -121,15 +122,13 @@ def waiting_time_accuracy() -> float | None:
         import mpmath
     except ImportError:
         return None
-    # private: the Newton waiting time is a kernel of the chain, not called on its own publicly
-    from micro import _renewal_kernels as RK
     mpmath.mp.dps = 40
     rng = np.random.default_rng(0)
     worst = 0.0
     for _ in range(3000):
         a = 10 ** rng.uniform(-5, 0)
         D, z = 10 ** rng.uniform(-6, 1), 10 ** rng.uniform(-8, 3)
-        t = RK.waiting_time(z, D, a, 1 - a)
+        t = H.waiting_time(z, D, a, 1 - a)
         ref = mpmath.findroot(lambda s: a * s + (1 - a) * D * (1 - mpmath.exp(-s)) - z, t)
         worst = max(worst, abs(t - float(ref)) / float(ref))
     return worst

@@ -17,7 +17,7 @@ The map is piecewise smooth (the number of steps in a loading phase, thresholds 
 cell edges, cells dropped below ``CELL_FLOOR``): at k0 = 0.01, 0.9 V^c, cell
 kappa zbar / 20, forward and central differences at a step of 1e-5 of the mass differ by
 3 % of ``|J v|``, and the map's round-off is a few 1e-8 of the mass, where the residual
-stalls (docs/validation/micro_cohort.md section 5; benchmarks/micro_cohort_newton_krylov.py).
+stalls (docs/validation/micro_cohort.md section 5; studies/micro_cohort_newton_krylov.py).
 Its evaluations do not depend on the number of numba threads (the kernels sum fixed
 chunks in a fixed order).
 

@@ -45,7 +45,7 @@ log = logging.getLogger(__name__)
 #: error (NaN, not known).  From d = 0.2 down to here the bound (the change from the run
 #: at twice the step and cell, plus both fixed points' errors) was checked against the
 #: Richardson limit of two finer levels at k0 = 0.3, 0.1, 0.01 and 1e-3
-#: (``benchmarks/micro_transition_error_check.py``,
+#: (``studies/micro_transition_error_check.py``,
 #: docs/validation/micro_transition.md): it covers the true error 3 to 20 times over.
 #: Closer, at k0 = 0.01, d = 0.01, the fixed point at dt = 0.02 is no longer certified
 #: and the finer levels differ by 6 % of the amplitude.

@@ -121,7 +121,7 @@ NEWTON_TOL = 0.5
 #: the loading phase is shorter than SHORT_PHASE and shocks all but total); one that
 #: extrapolated (Aitken) such a sequence without the acceleration says in its message that
 #: its error estimate can miss a slower mode (measured:
-#: benchmarks/micro_cohort_estimate_check.py).  (Steps below tol / 100 say nothing alone:
+#: studies/micro_cohort_estimate_check.py).  (Steps below tol / 100 say nothing alone:
 #: they can be a stress passing through zero steps; the state's move bounds what remains,
 #: :func:`_state_tail`.)
 SLOW_CAVEAT = 0.9
@@ -846,7 +846,7 @@ WINDOW = 5
 #: distance, and at 0.99 V^c took 146 cycles where 86 do) and rises as the slowest mode takes
 #: over after a kink (at 0.99 V^c from 2e-4 to 4.8e-4): over 10 or 15 cycles it claimed 0.8
 #: of the distance at two cycles there, over 5 cycles 0.8 at another path's stop; over 20 it
-#: covered every cycle of the sequences replayed (benchmarks/micro_cohort_state_tail_check.py,
+#: covered every cycle of the sequences replayed (studies/micro_cohort_state_tail_check.py,
 #: docs/validation/micro_cohort.md section 5).
 SENSITIVITY_WINDOW = 20
 

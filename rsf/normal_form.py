@@ -1,5 +1,5 @@
 r"""Normal forms of the loss of stability of steady sliding at :math:`V^c`
-(``docs/reference/rsf.md`` §19 has the derivations).
+(``docs/reference/rsf.md`` §15 has the derivations).
 
 * :math:`a > 0`: a Hopf bifurcation.  :func:`hopf_normal_form` computes its first Lyapunov
   coefficient :math:`l_1` (Kuznetsov, *Elements of Applied Bifurcation Theory*, §3.5,
@@ -362,7 +362,7 @@ class HopfNormalForm:
 def _closed_form_l1(K: float, a: float, om1: float, om2: float, code: int) -> tuple[float, float]:
     r"""l1 in :math:`\tau = Vt/D_c` for the aging, slip and PRZ laws without damping, for
     :math:`q = ((K+a)/a,\ i\sqrt{K/a} - 1)` (not normalised); from the symbolic evaluation
-    of Eq. (3.20) (``docs/reference/rsf.md`` §19).  Returns (l1, |q|^2)."""
+    of Eq. (3.20) (``docs/reference/rsf.md`` §15).  Returns (l1, |q|^2)."""
     base = -(K + a) / (4.0 * math.sqrt(K) * a ** 2.5)
     if code == AGING:
         l1 = base * a * (om1 - om2)
@@ -547,7 +547,7 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(48)
 @dataclass(frozen=True)
 class StickSlipNormalForm:
     r"""The stick-slip cycle born at :math:`V^c` when :math:`a = 0` (``docs/reference/rsf.md``
-    §19).
+    §15).
 
     The cycle is a stick from the landing :math:`y_1` to :math:`y_2` and an instantaneous
     slip back (:math:`y = \ln(V\theta/D_c)`); it is the fixed point of the landing-to-landing

@@ -8,7 +8,8 @@ API only.  Run from the repository's top (``pip install -e '.[asv]'`` first)::
     asv run -E existing --set-commit-hash $(git rev-parse HEAD)   # all, results saved
     asv run -E existing --quick -b RSFClassical                    # each once, not saved
 
-The accuracy-versus-cost studies stay scripts beside this folder (benchmarks/README.md).
+The accuracy-versus-cost scripts stay beside this folder (benchmarks/README.md); the
+validation studies are in studies/ (studies/README.md).
 """
 from __future__ import annotations
 

@@ -72,7 +72,7 @@ def test_close_to_vc_the_discretisation_error_is_not_known(cohort_calls, monkeyp
 def test_close_to_vc_the_bound_covers_the_next_finer_level(k0, d):
     """Between d = 0.2 and micro.api.NEAR_VC the reported bound covers the row's distance
     from a finer level's Richardson limit (dt and cell halved, first order: the most
-    cautious; benchmarks/micro_transition_error_check.py has two finer levels)."""
+    cautious; studies/micro_transition_error_check.py has two finer levels)."""
     assert d >= api.NEAR_VC
     model = micro.Model(k0=k0)
     V = (1.0 - d) * micro.critical_velocity(model).Vc

@@ -221,7 +221,7 @@ def test_a_shock_keeps_the_mean_lag_at_zero():
 def test_a_run_close_to_vc_is_accelerated_and_bounds_its_error_by_the_slowest_mode():
     """Close to V^c the cycles contract by 0.9-0.98 a cycle, and five plain cycles can hide a
     mode slower than the one they show (at k0 = 1e-3, 0.95 V^c the Aitken estimate was
-    measured 25 times too small: benchmarks/micro_cohort_estimate_check.py).  Such a run is
+    measured 25 times too small: studies/micro_cohort_estimate_check.py).  Such a run is
     accelerated, and each error is at least the last step times m / (1 - m), m the slowest
     multiplier; a run far from V^c is not accelerated."""
     model = micro.Model(k0=0.001)
@@ -613,7 +613,7 @@ def _assert_plain_cycles_stay(res, n: int) -> None:
 
 def test_close_to_vc_the_run_finds_newtons_fixed_point():
     """k0 = 1e-3, 0.95 V^c at twice the default steps and cells: Newton's method with the
-    map's whole Jacobian (benchmarks/micro_cohort_newton_check.py, 242 cycles for the
+    map's whole Jacobian (studies/micro_cohort_newton_check.py, 242 cycles for the
     Jacobian; from the first shock's image, as here) has its fixed point at sigma_max
     0.9071577854, sigma_min 0.8999000063.  The
     preconditioned Anderson iteration gets there (the plain cycles' Aitken rule stopped
@@ -777,7 +777,7 @@ def test_close_to_vc_the_fine_cell_is_certified_by_newton_krylov():
     (multiplier 1.028), Anderson's iteration stalls, and the run used to report error NaN
     (its plain cycles passed the stopping test 2e-6 to 3e-5 from where others stopped).
     Newton-Krylov certifies the fixed point, and plain cycles from it stay within its
-    error.  At the step this path takes, benchmarks/micro_cohort_newton_krylov.py
+    error.  At the step this path takes, studies/micro_cohort_newton_krylov.py
     (``--points 40:0.02 --no-consistent``) solved the same map to its round-off: sigma_max
     0.9141064424 (2.3e-9; the run: 0.9141064447, error 5.7e-8).  (The step moved from
     0.0083801882 and the reference from 0.9141064382 when the coarse run's error rule took

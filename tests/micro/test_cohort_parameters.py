@@ -11,7 +11,7 @@ The references share no code with the cohort method:
 * the N-block simulation (``micro.nblock``) at N = 1e6 and 2.5e5.  Its means over 40
   cycles, their standard errors and the finite-N trend come from
   ``benchmarks/results/micro_cohort_parameters_nblock.csv``, written by
-  ``python benchmarks/micro_cohort_parameters.py --solver nblock`` (docs/validation/
+  ``python -m studies micro_cohort_parameters --solver nblock`` (docs/validation/
   micro_cohort.md, section 6).  ``sigma_peak`` there is the largest stress of each cycle
   from the run's binned maxima, the quantity the cohort method calls sigma_max;
 * sigma_min = f_th - kappa zbar exactly where shocks are total

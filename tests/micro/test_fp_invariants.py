@@ -191,7 +191,7 @@ def test_the_bisection_decides_each_velocity_from_the_slowest_steady_state(caplo
     # density (a small step down from steady sliding), and without the check at eps / 2 a
     # cycle counts only above the grid's resolution.  (Coarse bin and rel_tol 0.12, for speed:
     # 4 runs, 15 s (rel_tol 0.05: 6 runs, 22 s); here V^c ~ 0.86; finer bins in
-    # benchmarks/micro_fp_vc_convergence.py.)
+    # studies/micro_fp_vc_convergence.py.)
     model = micro.Model(k0=0.1)
     eps = 0.024
     with caplog.at_level(logging.INFO, logger="micro"):
@@ -312,7 +312,7 @@ def test_cycle_amplitude_is_the_median_drop_of_the_later_half():
 # default run checks the direct V^c against the same brackets (test_renewal.py)
 def test_the_check_at_half_the_bin_brackets_the_n_block_critical_velocity():
     # k0 = 0.3 at the phase diagram's coarse bin eps = 0.025.  The N-block (N = 1e5,
-    # stepped down from steady sliding at V = 2, as benchmarks/micro_fp_vs_nblock_hopf_amplitude.py)
+    # stepped down from steady sliding at V = 2, as studies/micro_fp_vs_nblock_hopf_amplitude.py)
     # keeps a cycle of 0.042 at V = 0.15 and only its finite-N noise (0.005, which falls
     # like N^-1/2) at V = 0.25.  The bisection without the check put V^c at 0.12: the
     # physical cycle at V = 0.125 (drop 1.99 eps, no global shock) was taken for the grid's.

@@ -1,4 +1,4 @@
-"""The normal forms of RS's transition at V^c (rsf.normal_form; docs/reference/rsf.md §19):
+"""The normal forms of RS's transition at V^c (rsf.normal_form; docs/reference/rsf.md §15):
 the first Lyapunov coefficient against closed forms and against rsf's own limit cycles,
 the a = 0 stick-slip reduction against rsf.limit_cycle, and the one test of the transition."""
 from __future__ import annotations
@@ -154,7 +154,7 @@ def test_hopf_amplitude_against_the_simulated_cycle():
 @pytest.mark.slow
 @pytest.mark.parametrize("case", ["aging", "slip", "log-aging", "log-slip"])
 def test_hopf_amplitude_ratio_tends_to_one_over_three_decades(case):
-    """The benchmark's check (benchmarks/rsf_normal_form.py): amplitude / (c d^(1/2)) within
+    """The benchmark's check (studies/rsf_normal_form.py): amplitude / (c d^(1/2)) within
     1e-3 of 1 at d = 1e-4, 1e-5, 1e-6, 1e-7, and closer at smaller d."""
     model = {"aging": rsf.SpringSlider(k0=0.1, a=1e-3),
              "slip": rsf.SpringSlider(k0=0.1, a=1e-3, state_law="slip"),
