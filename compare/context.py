@@ -37,7 +37,7 @@ import rsf
 from . import figures, fits
 from .params import PAPER_K0, Settings
 from .runner import Runner
-from .summary import fmt, pct
+from .summary import STEADY_TOL, fmt, pct
 from .tasks import StationaryTask, SteadyTask, Task, VcTask
 
 __all__ = ["Context", "micro_frame", "sig"]
@@ -463,7 +463,7 @@ class Context:
         chk = t["steady_fit_checks"]
         lines = ["## Eq. (10) fitted to micro's exact steady branch", "",
                  f"mu_ss = mu_inf(k0) + A/(V + B) fitted to {len(t['steady_fit_residuals'])} exact steady points "
-                 f"(micro's direct method, to 1e-11; V from just above V^c to {fmt(s.branch_span, 3)} V^c at each "
+                 f"(micro's direct method, to {STEADY_TOL:g}; V from just above V^c to {fmt(s.branch_span, 3)} V^c at each "
                  f"k0, and the reference branch at k0 = {s.reference_k0:g}, steady at every V):", "",
                  f"A = {fmt(v['A'])} ± {fmt(v['A_err'], 2)}, B = {fmt(v['B'])} ± {fmt(v['B_err'], 2)} "
                  f"(paper: A = {rsf.PAPER_A}, B = {rsf.PAPER_B}); rms residual {fmt(v['steady_rms'], 3)}, "

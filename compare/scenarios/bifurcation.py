@@ -125,8 +125,12 @@ def summary(ctx: Context, part: Part) -> list[str]:
 
 
 def _critical(t) -> list[str]:
+    crit = t["critical_velocity"]
+    rel = (crit.Vc_micro_err / crit.Vc_micro).to_numpy(float)
+    rel = rel[np.isfinite(rel)]
+    err = f"relative error at most {fmt(float(rel.max()), 2)}" if rel.size else "error not known"
     lines = ["## Critical velocity per k0", "",
-             "Micro: exact (the root of branching ratio = 1; error below 1e-9 relative); RS: linear stability "
+             f"Micro: exact (the root of branching ratio = 1; {err}); RS: linear stability "
              "with the fitted law and each D_c.", "",
              "| k0 | V^c micro | small-k0 asymptote | V^c RS, D_c (a) | V^c RS, D_c (b) | V^c RS (paper's law, D_c) |",
              "|---|---|---|---|---|---|"]

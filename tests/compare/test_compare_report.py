@@ -32,6 +32,17 @@ def test_critical_velocity_table_has_all_five_k0_and_the_kept_columns(rep):
     assert 0.70 < small.Vc_micro[0.1] < 0.75
 
 
+def test_summary_states_vc_error_and_branch_tolerance_as_computed(rep):
+    """The critical-velocity paragraph quotes the largest relative error of micro's V^c in this
+    run's table (it used to state a fixed 'error below 1e-9'), and the Eq. (10) paragraph the
+    steady tasks' own tolerance."""
+    crit = rep["critical_velocity"]
+    worst = float((crit.Vc_micro_err / crit.Vc_micro).max())
+    assert f"relative error at most {compare.summary.fmt(worst, 2)}" in rep.summary
+    assert "error below 1e-9" not in rep.summary
+    assert f"micro's direct method, to {compare.tasks.SteadyTask.tol:g};" in rep.summary
+
+
 def test_rs_critical_velocity_is_the_closed_form_root(rep):
     """RS's V^c of the report against k0 D_c = A V/(V + B)^2 solved here by hand."""
     crit = rep["critical_velocity"]
