@@ -351,7 +351,7 @@ def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
     micro_div, rs_div = tr.get("growth_diverges"), rs_tr.get("growth_diverges")
     if micro_div and rs_div:
         out.append("At a = 0 both models lose stability at V^c the same singular way, not by a Hopf bifurcation: "
-                   f"the unstable mode's growth rate diverges as V → V^c (micro: {growth(tr)}; RS: {growth(rs_tr)}).")
+                   f"the unstable mode's growth rate diverges at V^c (micro: {growth(tr)}; RS: {growth(rs_tr)}).")
     else:
         said = [f"{who}'s growth rate {'diverges' if x['growth_diverges'] else 'vanishes'} as V → V^c "
                 f"({growth(x)})" for who, x in (("micro", tr), ("RS", rs_tr)) if "growth_diverges" in x]
@@ -367,7 +367,7 @@ def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
                    f"c0 = {fmt(law['c0'], 4)}, c2 = {fmt(law['c2'], 3)}{check}.")
     lo, hi, n = memory_ratio(pts, s.hopf_k0, s.k2)
     total = (f": above d = k0/k2 = {s.hopf_k0 / s.k2:.2g} (total shocks) the {n} cycles lie at {fmt(lo, 2)}-"
-             f"{fmt(hi, 2)} times the reset model's derived law, the memory factor; below, it crosses over"
+             f"{fmt(hi, 2)} times the reset model's derived law (memory and O(k0) effects); below, it crosses over"
              if n else ": it crosses over at d of about k0/k2")
     out.append("Micro's amplitude follows no single power law" + total
                + " (docs/reference/micro_transition.md).")
