@@ -372,7 +372,9 @@ class DcFit:
         Root-mean-square extrema residual at the optimum over the ``n_stick_slip`` points
         (2 values each); ``rms_per_k0`` splits it by k0.
     profile : DataFrame
-        ``Dc, misfit, rms, n_stick_slip, n_disagree`` on the scan grid.
+        ``Dc, rss, rms, misfit, n_stick_slip, n_disagree`` on the scan grid: the sum of the
+        squared residuals over the points in the misfit, its rms per value, the misfit (their
+        mean per point), how many points it has and how many disagree in regime.
     points : DataFrame
         The micro points with RS's values at the optimum, the residuals, whether each enters
         the misfit there (``in_misfit``), whether the regimes agree, and the D_c at which its
@@ -617,8 +619,8 @@ def fit_dc(frame: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateLaw], 
     per_k0["rms"] = np.sqrt(per_k0.sq / (2 * per_k0.n_points))
     per_k0 = per_k0.drop(columns="sq")
     agree = float(np.mean(out.regime_agrees))
-    profile = pd.DataFrame({"Dc": grid, "misfit": mis_grid, "rms": np.sqrt(mis_grid / 2.0),
-                            "n_stick_slip": BOTH.sum(axis=1), "n_disagree": DIS})
+    profile = pd.DataFrame({"Dc": grid, "rss": mis_grid * BOTH.sum(axis=1), "rms": np.sqrt(mis_grid / 2.0),
+                            "misfit": mis_grid, "n_stick_slip": BOTH.sum(axis=1), "n_disagree": DIS})
     one_sided, switch = "", math.nan
     if sw.size:
         j = int(np.argmin(np.abs(np.log(sw / Dc))))
