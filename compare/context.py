@@ -348,7 +348,8 @@ class Context:
         the misfit within ``profile_factor`` of its minimum), ``profile_factor``, ``rms_a``,
         ``one_sided``, ``n_disagree`` (points whose regimes differ at the optimum), ``Dc_b``,
         ``ratio_a_b``, and the small-k0 closed form of D_c (a) (:func:`compare.fits.dc_small_k0`)
-        and its ratio to D_c (b), ``Dc_a_small_k0, ratio_small_k0``.  Each k0's misfit profile is the table ``dc_profile_per_k0``."""
+        and its ratio to D_c (b), ``Dc_a_small_k0, ratio_small_k0``.  Each k0's misfit
+        profile is the table ``dc_profile_per_k0``."""
         per_b = self.dc_critical.per_k0.set_index("k0").Dc_law
         rows, profiles = [], []
         for k0, grp, future in self._per_k0_fits:
@@ -463,7 +464,8 @@ class Context:
         chk = t["steady_fit_checks"]
         lines = ["## Eq. (10) fitted to micro's exact steady branch", "",
                  f"mu_ss = mu_inf(k0) + A/(V + B) fitted to {len(t['steady_fit_residuals'])} exact steady points "
-                 f"(micro's direct method, to {STEADY_TOL:g}; V from just above V^c to {fmt(s.branch_span, 3)} V^c at each "
+                 f"(micro's direct method, to {STEADY_TOL:g}; V from just above V^c to {fmt(s.branch_span, 3)} V^c "
+                 f"at each "
                  f"k0, and the reference branch at k0 = {s.reference_k0:g}, steady at every V):", "",
                  f"A = {fmt(v['A'])} ± {fmt(v['A_err'], 2)}, B = {fmt(v['B'])} ± {fmt(v['B_err'], 2)} "
                  f"(paper: A = {rsf.PAPER_A}, B = {rsf.PAPER_B}); rms residual {fmt(v['steady_rms'], 3)}, "

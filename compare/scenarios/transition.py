@@ -8,10 +8,11 @@ their error where it is known) and the N-block at two sizes; RS's cycles with th
 asymptote derived from its stick-slip map (:func:`rsf.stick_slip_normal_form`); micro's
 total-shock law derived from its reset model, (R) of docs/reference/micro_transition.md,
 where it holds (d >~ k0/k2), and the measured memory factor and linear law of the validation
-record, read from the package's data file (:func:`measured_transition`).  One power law per method (:func:`compare.fits.transition_fits`: its
-exponent, confidence interval and the range of d it rests on; only points whose error is
-known), :func:`compare.fits.classify_transition`'s evidence, and the verdict as one
-paragraph (:func:`verdict`).
+record, read from the package's data file (:func:`measured_transition`).  One power law per
+method (:func:`compare.fits.transition_fits`: its exponent, confidence interval and the range
+of d it rests on; only points whose error is known), :func:`compare.fits.classify_transition`'s
+evidence, and the verdict as one paragraph of at most :data:`VERDICT_WORDS` words
+(:func:`verdict`).
 """
 from __future__ import annotations
 
@@ -426,7 +427,8 @@ def _laws_summary(s: Settings, t: dict[str, pd.DataFrame]) -> list[str]:
     r = laws[laws.law == "reset (R), derived"]
     if len(r):
         said.append(f"the reset model's total-shock law (R), A_r = k2 zbar q tau_r(q) ≈ 2 k2 zbar d_r (1 − d_r/3) "
-                    f"with d_r = 1 − k0 V/(k2 gamma zbar), derived (docs/reference/micro_transition.md, section 3.1), "
+                    "with d_r = 1 − k0 V/(k2 gamma zbar), derived (docs/reference/micro_transition.md, "
+                    f"section 3.1), "
                     f"from d = k0/k2 = {fmt(r.d.min(), 3)}, where shocks become total, to d = {fmt(r.d.max(), 2)}")
     m = laws[laws.law == "reset (R) x measured memory factor"]
     if len(m):
@@ -434,7 +436,8 @@ def _laws_summary(s: Settings, t: dict[str, pd.DataFrame]) -> list[str]:
                     f"{fmt(m.d_r.max(), 2)} here), not derived")
     lin = laws[laws.law == "linear, measured"]
     if len(lin):
-        said.append(f"the linear law deep in the partial-shock regime, A = {fmt(float((lin.amplitude / lin.d).mean()), 2)} d, "
+        c = float((lin.amplitude / lin.d).mean())
+        said.append(f"the linear law deep in the partial-shock regime, A = {fmt(c, 2)} d, "
                     f"measured at d = {fmt(lin.d.min(), 2)} to {fmt(lin.d.max(), 2)} (prefactor not derived)")
     return ["`hopf.png` also draws micro's laws (table `hopf_micro_laws`): " + "; ".join(said) + ". The measured "
             f"constants come from `compare/data/{MEASURED_FILE}`, whose header names the study, its command "
