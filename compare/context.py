@@ -37,7 +37,7 @@ import rsf
 from . import figures, fits
 from .params import PAPER_K0, Settings
 from .runner import Runner
-from .summary import fmt, pct
+from .summary import STEADY_TOL, fmt, pct
 from .tasks import StationaryTask, SteadyTask, Task, VcTask
 
 __all__ = ["Context", "micro_frame", "sig"]
@@ -334,17 +334,24 @@ class Context:
         self.tables["dc_rms_per_k0"] = fit.rms_per_k0
         self.values.update(Dc=fit.Dc, Dc_err=fit.Dc_err, Dc_rms=fit.rms, Dc_profile=fit.Dc_profile,
                            regime_agreement=fit.regime_agreement, Dc_one_sided=fit.one_sided,
-                           Dc_switch=fit.switch)
+                           Dc_switch=fit.switch, Dc_n_stick_slip=fit.n_stick_slip, Dc_n_disagree=fit.n_disagree,
+                           Dc_profile_factor=fit.profile_factor)
         return fit
 
     @cached_property
     def dc_per_k0(self) -> pd.DataFrame:
         """D_c (a) fitted at each k0 of ``fp_k0`` alone (its stick-slip and steady points),
         beside D_c (b) at that k0 (the fitted law's slope at micro's exact V^c): how far one
-        D_c is from carrying every k0.  Columns ``k0, n_points, Dc_a, Dc_a_lo, Dc_a_hi``
-        (the profile interval), ``rms_a``, ``Dc_b``, ``ratio_a_b``."""
+        D_c is from carrying every k0.  Columns ``k0, n_points`` (steady and stick-slip),
+        ``n_cycles`` (micro's stick-slip points), ``n_stick_slip`` (those in the misfit at the
+        optimum: RS in stick-slip too), ``Dc_a, Dc_a_lo, Dc_a_hi`` (the profile interval:
+        the misfit within ``profile_factor`` of its minimum), ``profile_factor``, ``rms_a``,
+        ``one_sided``, ``n_disagree`` (points whose regimes differ at the optimum), ``Dc_b``,
+        ``ratio_a_b``, and the small-k0 closed form of D_c (a) (:func:`compare.fits.dc_small_k0`)
+        and its ratio to D_c (b), ``Dc_a_small_k0, ratio_small_k0``.  Each k0's misfit
+        profile is the table ``dc_profile_per_k0``."""
         per_b = self.dc_critical.per_k0.set_index("k0").Dc_law
-        rows = []
+        rows, profiles = [], []
         for k0, grp, future in self._per_k0_fits:
             try:
                 try:
@@ -358,11 +365,20 @@ class Context:
                 log.warning("D_c (a) at k0 = %g alone: %s", k0, exc)
                 continue
             Dc_b = float(per_b.get(k0, math.nan))
-            rows.append({"k0": float(k0), "n_points": fit.n_points, "Dc_a": fit.Dc, "Dc_a_lo": fit.Dc_profile[0],
-                         "Dc_a_hi": fit.Dc_profile[1], "rms_a": fit.rms, "one_sided": fit.one_sided,
-                         "Dc_b": Dc_b, "ratio_a_b": fit.Dc / Dc_b if Dc_b > 0 else math.nan})
+            Dc_lim = fits.dc_small_k0(grp, self.law_for(k0))
+            rows.append({"k0": float(k0), "n_points": fit.n_points,
+                         "n_cycles": int((fit.points.regime_micro == "stick-slip").sum()),
+                         "n_stick_slip": fit.n_stick_slip, "Dc_a": fit.Dc, "Dc_a_lo": fit.Dc_profile[0],
+                         "Dc_a_hi": fit.Dc_profile[1], "profile_factor": fit.profile_factor, "rms_a": fit.rms,
+                         "one_sided": fit.one_sided, "n_disagree": fit.n_disagree,
+                         "Dc_b": Dc_b, "ratio_a_b": fit.Dc / Dc_b if Dc_b > 0 else math.nan,
+                         "Dc_a_small_k0": Dc_lim, "ratio_small_k0": Dc_lim / Dc_b if Dc_b > 0 else math.nan})
+            profiles.append(fit.profile.assign(k0=float(k0)))
         frame = pd.DataFrame(rows).sort_values("k0", ascending=False, ignore_index=True) if rows else pd.DataFrame()
         self.tables["dc_per_k0"] = frame
+        if profiles:
+            prof = pd.concat(profiles, ignore_index=True)
+            self.tables["dc_profile_per_k0"] = prof[["k0"] + [c for c in prof.columns if c != "k0"]]
         return frame
 
     @cached_property
@@ -448,7 +464,8 @@ class Context:
         chk = t["steady_fit_checks"]
         lines = ["## Eq. (10) fitted to micro's exact steady branch", "",
                  f"mu_ss = mu_inf(k0) + A/(V + B) fitted to {len(t['steady_fit_residuals'])} exact steady points "
-                 f"(micro's direct method, to 1e-11; V from just above V^c to {fmt(s.branch_span, 3)} V^c at each "
+                 f"(micro's direct method, to {STEADY_TOL:g}; V from just above V^c to {fmt(s.branch_span, 3)} V^c "
+                 f"at each "
                  f"k0, and the reference branch at k0 = {s.reference_k0:g}, steady at every V):", "",
                  f"A = {fmt(v['A'])} ± {fmt(v['A_err'], 2)}, B = {fmt(v['B'])} ± {fmt(v['B_err'], 2)} "
                  f"(paper: A = {rsf.PAPER_A}, B = {rsf.PAPER_B}); rms residual {fmt(v['steady_rms'], 3)}, "

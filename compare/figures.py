@@ -25,6 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+import rsf  # noqa: E402
 from micro.api import NEAR_VC  # noqa: E402
 
 from . import fits  # noqa: E402
@@ -241,12 +242,28 @@ def steady_fit(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -
 
 @_figure
 def dc_profile(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path:
+    """D_c (a)'s misfit against D_c.  Top: the rms of the extrema where both models are in
+    stick-slip, all k0 (``dc_profile``) and each k0 alone (``dc_profile_per_k0``), with each
+    point's regime switch W(V)/k0 marked in its k0's colour, D_c (a) with its interval and
+    D_c (b) with its per-k0 range.  Bottom: the points in the misfit and the points whose
+    regimes disagree, against D_c (regime agreement, kept apart from the misfit)."""
     prof = t["dc_profile"]
-    fig, ax = plt.subplots(figsize=(6.5, 4.3))
-    ax.loglog(prof.Dc, prof.rms, "o-", ms=3, label="rms(sigma_RS - sigma_micro) on the scan grid")
-    sw = t["dc_points"].Dc_switch.to_numpy(float)
-    for j, s in enumerate(sw[np.isfinite(sw) & (sw > 0)]):
-        ax.axvline(s, color="0.6", ls=":", lw=0.7, label="regime switch of a point" if j == 0 else None)
+    per = t.get("dc_profile_per_k0")
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7.0, 6.4), sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
+    ax.loglog(prof.Dc, prof.rms, "o-", ms=3, color="k", label="all k0: rms of the extrema where both are in stick-slip")
+    k0s = sorted(t["dc_points"].k0.unique(), reverse=True)
+    colour = {k: _COLORS.get(float(k), f"C{5 + i}") for i, k in enumerate(k0s)}
+    if per is not None and len(per):
+        for k, grp in per.groupby("k0", sort=False):
+            ax.loglog(grp.Dc, grp.rms, "-", lw=0.9, color=colour.get(k, "0.5"), label=f"k0 = {k:g} alone")
+    pts = t["dc_points"]
+    for k, grp in pts.groupby("k0"):
+        sw = grp.Dc_switch.to_numpy(float)
+        sw = sw[np.isfinite(sw) & (sw > 0)]
+        for s in sw:
+            ax.axvline(s, color=colour.get(k, "0.6"), ls=":", lw=0.8)
+            ax2.axvline(s, color=colour.get(k, "0.6"), ls=":", lw=0.8)
+    ax.plot([], [], ":", color="0.4", label="a point's regime switch W(V)/k0 (colour: its k0)")
     Dc = values["Dc"]
     lo, hi = values["Dc_profile"]
     if values.get("Dc_one_sided"):
@@ -254,16 +271,23 @@ def dc_profile(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -
         lab = f"(a) D_c = {Dc:.3g}: on a switch, one-sided D_c {bound} {values['Dc_switch']:.3g}"
     else:
         lab = f"(a) D_c = {Dc:.3g} ± {values['Dc_err']:.2g}"
-    ax.axvline(Dc, color="k", lw=1, label=lab)
-    ax.axvspan(lo, hi, color="k", alpha=0.1, label=f"profile interval [{lo:.3g}, {hi:.3g}]")
+    ax.axvline(Dc, color="k", lw=1.2, label=lab)
+    ax.axvspan(lo, hi, color="k", alpha=0.1, label=f"misfit within x{values.get('Dc_profile_factor', math.nan):.3g} "
+                                                   f"of its minimum: [{lo:.3g}, {hi:.3g}]")
     if "Dc_vc" in values:  # (b) is computed by the scenarios that need V^c (not by shs alone)
         b_lo, b_hi = values["Dc_vc_range"]
-        ax.axvline(values["Dc_vc"], color="C3", lw=1, label=f"(b) V^c matching: {values['Dc_vc']:.3g}")
-        ax.axvspan(b_lo, b_hi, color="C3", alpha=0.1, label=f"(b) per-k0 range [{b_lo:.3g}, {b_hi:.3g}]")
-    ax.axvline(0.06, color="C2", ls="--", lw=0.8, label="paper D_c = 0.06")
-    ax.set_xlabel("D_c")
+        ax.axvline(values["Dc_vc"], color="C3", lw=1, ls="--", label=f"(b) V^c matching: {values['Dc_vc']:.3g}")
+        ax.axvspan(b_lo, b_hi, color="C3", alpha=0.08, label=f"(b) per-k0 range [{b_lo:.3g}, {b_hi:.3g}]")
+    ax.axvline(rsf.PAPER_DC, color="C2", ls="-.", lw=0.8, label=f"paper D_c = {rsf.PAPER_DC:g}")
     ax.set_ylabel("rms residual of sigma_max, sigma_min")
-    ax.legend(fontsize=6, loc="upper right")
+    ax.set_title("D_c (a): misfit of the extrema where both models are in stick-slip", fontsize=9)
+    ax.legend(fontsize=6, loc="upper left", ncol=2)
+    ax2.semilogx(prof.Dc, prof.n_stick_slip, "o-", ms=3, color="k", label="points in the misfit (both stick-slip)")
+    ax2.semilogx(prof.Dc, prof.n_disagree, "s-", ms=3, color="C3", label="points whose regimes disagree")
+    ax2.axvline(Dc, color="k", lw=1.2)
+    ax2.set_xlabel("D_c")
+    ax2.set_ylabel("points (all k0)")
+    ax2.legend(fontsize=6)
     return _save(fig, path)
 
 
@@ -296,8 +320,10 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     against d, log-log, each against its own exact V^c: the points with their error bars
     (filled: the error is known and the point is fitted; open: not known, not fitted),
     each method's fitted law over the d it rests on with its interval, and RS's derived
-    asymptote c0 d^(1/2) (1 + c2 d) (``values['rs_amplitude_law']``); micro's amplitude has
-    no derived prefactor, and the figure says so.  On the left, micro's derived growth-rate asymptote
+    asymptote c0 d^(1/2) (1 + c2 d) (``values['rs_amplitude_law']``), and micro's laws
+    (``hopf_micro_laws``): the reset model's total-shock law (R), derived, where shocks are
+    total (d >~ k0/k2), the same times the measured memory factor, and the measured linear
+    law deep in the partial-shock regime, each labelled derived or measured.  On the left, micro's derived growth-rate asymptote
     (``micro_spectrum.growth_rate_asymptote``, :func:`micro.growth_rate_near_vc`)."""
     pts, fit, spec = t["hopf_points"], t["hopf_fit"], t["micro_spectrum"]
     k0 = float(pts.k0.iloc[0]) if len(pts) else math.nan
@@ -372,13 +398,27 @@ def hopf(t: dict[str, pd.DataFrame], values: dict[str, Any], path: Path) -> Path
     if lo < NEAR_VC:
         keep(ax.axvspan(lo, min(NEAR_VC, hi), color="0.5", alpha=0.1, lw=0),
              f"d < {NEAR_VC:g}: micro's law not settled (the cohort's error not known)")
-    ax.text(0.02, 0.97, "micro: no single power law; crossover at d ~ k0/k2,\nlinear in d again deep below it "
-            "(scaling argument, prefactor not derived)", transform=ax.transAxes, ha="left", va="top",
-            fontsize=8, color="C1")
+    laws = t.get("hopf_micro_laws")
+    if laws is not None and len(laws):
+        style = {"reset (R), derived": ("-.", 1.0, "micro, derived for d > k0/k2 (total shocks): reset model (R), "
+                                                   "A_r = k2 zbar q tau_r(q) ~ 2 k2 zbar d_r (1 - d_r/3)"),
+                 "reset (R) x measured memory factor": (":", 1.3, "micro: (R) x memory factor c_m (measured at "
+                                                                   "small k0, validation record; not derived)"),
+                 "linear, measured": ("-", 2.2, "micro, measured (validation record): linear law A = c d, "
+                                                "c = {c:.2f} (prefactor not derived)")}
+        for name, grp in laws.groupby("law", sort=False):
+            if name not in style or not len(grp):
+                continue
+            ls, lw, lab = style[name]
+            keep(ax.plot(grp.d, grp.amplitude, ls, color="C1", lw=lw, alpha=0.8),
+                 lab.format(c=float((grp.amplitude / grp.d).mean())))
+        start = laws.d[laws.law == "reset (R), derived"]
+        if len(start):   # d = k0/k2: shocks total above, partial below
+            ax.axvline(float(start.min()), color="C1", lw=0.5, ls="--", alpha=0.5)
     ax.set_xlabel("d = (V^c - V) / V^c (each model's own exact V^c)")
     ax.set_ylabel("sigma_max - sigma_min")
     ax.set_title("Amplitude near V^c: points with their errors, fitted laws [95 % CI] over the d they rest on,\n"
-                 "RS's derived asymptote (micro: no prefactor derived)", fontsize=9)
+                 "RS's derived asymptote, micro's derived total-shock law and measured linear law", fontsize=9)
     ax.legend([hd for hd, _ in handles], [lb for _, lb in handles], fontsize=6, loc="lower right")
     return _save(fig, path)
 

@@ -33,6 +33,7 @@ __all__ = [
     "DcFit",
     "fit_dc",
     "rs_diagram",
+    "dc_small_k0",
     "dc_from_critical_velocity",
     "DcCriticalFit",
     "fit_dc_critical",
@@ -345,35 +346,49 @@ def dc_from_critical_velocity(A: float, B: float, k0: float, Vc: float) -> float
 
 @dataclass
 class DcFit:
-    r"""The critical slip distance that best matches the bifurcation diagrams.
+    r"""The critical slip distance that best matches micro's stick-slip extrema.
 
     Attributes
     ----------
     Dc : float
-        Least-squares optimum of the stress residual over the points.
+        The optimum of the extrema misfit: the mean over the points where both models are
+        in stick-slip of :math:`(\sigma^{RS}_{max} - \sigma^{micro}_{max})^2 +
+        (\sigma^{RS}_{min} - \sigma^{micro}_{min})^2`.  Which points those are depends on
+        D_c (RS is in stick-slip at (k0, V) for :math:`k_0 D_c < W(V)`), so the misfit is
+        smooth between the points' regime switches and steps at each; regime agreement is
+        reported apart (``n_disagree``, ``regime_agreement``, ``points.regime_rs``).
     one_sided, switch : str, float
-        The residual jumps where the RS regime of a point switches (at
-        :math:`k_0 D_c = W(V)`).  When the optimum sits on such a switch (within 1 %), the
-        data bound D_c from one side only: ``one_sided`` is ``'upper'`` (D_c <= switch) or
-        ``'lower'``, and ``switch`` is that D_c; otherwise ``''`` and NaN.
+        When the optimum sits on a regime switch of a point (within 1 %), the data bound
+        D_c from one side only: ``one_sided`` is ``'upper'`` (D_c <= switch) or ``'lower'``,
+        and ``switch`` is that D_c; otherwise ``''`` and NaN.
     Dc_err : float
-        Standard error: half the width of the bootstrap 16-84 % interval (resampling the
-        points); ``Dc_profile`` is the profile interval where
-        :math:`RSS \le RSS_{min}(1 + 1/(n-1))`.
-    rms : float
-        Root-mean-square residual at the optimum (stress units), over the 2n values
-        (σ_max and σ_min of each point); ``rms_per_k0`` splits it by k0.
+        Half the width of the bootstrap 16-84 % interval (resampling the points).
+    Dc_profile : (float, float)
+        The profile interval: the D_c range about the optimum where the misfit stays within
+        the factor ``profile_factor`` = 1 + 1/(n - 1) of its minimum (n = ``n_stick_slip``).
     Dc_bootstrap : (float, float)
         The bootstrap's 16 % and 84 % quantiles.
+    rms : float
+        Root-mean-square extrema residual at the optimum over the ``n_stick_slip`` points
+        (2 values each); ``rms_per_k0`` splits it by k0.
     profile : DataFrame
-        ``Dc, rss, rms`` on the scan grid.
+        ``Dc, rss, rms, misfit, n_stick_slip, n_disagree`` on the scan grid: the sum of the
+        squared residuals over the points in the misfit, its rms per value, the misfit (their
+        mean per point), how many points it has and how many disagree in regime.
     points : DataFrame
-        The micro points used with the RS values at the optimum, the residuals and the
-        D_c at which each point's RS regime switches (``Dc_switch``).
+        The micro points with RS's values at the optimum, the residuals, whether each enters
+        the misfit there (``in_misfit``), whether the regimes agree, and the D_c at which its
+        RS regime switches (``Dc_switch``, W(V)/k0).
     n_points : int
-        Micro points used.
+        Micro points used (steady and stick-slip).
+    n_stick_slip : int
+        Points in the misfit at the optimum: both models in stick-slip.
+    n_disagree : int
+        Points whose RS regime at the optimum is not micro's.
     regime_agreement : float
         The fraction of points whose RS regime at the optimum is micro's.
+    profile_factor : float
+        The factor of the profile interval.
     bootstrap : ndarray
         The bootstrap optima.
     """
@@ -391,13 +406,18 @@ class DcFit:
     bootstrap: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
     one_sided: str = ""
     switch: float = math.nan
+    n_stick_slip: int = 0
+    n_disagree: int = 0
+    profile_factor: float = math.nan
 
     def to_frame(self) -> pd.DataFrame:
         return pd.DataFrame([{"Dc": self.Dc, "Dc_err": self.Dc_err, "Dc_profile_low": self.Dc_profile[0],
                               "Dc_profile_high": self.Dc_profile[1], "Dc_bootstrap_16": self.Dc_bootstrap[0],
                               "Dc_bootstrap_84": self.Dc_bootstrap[1], "rms": self.rms,
-                              "n_points": self.n_points, "regime_agreement": self.regime_agreement,
-                              "one_sided": self.one_sided, "switch": self.switch}])
+                              "n_points": self.n_points, "n_stick_slip": self.n_stick_slip,
+                              "n_disagree": self.n_disagree, "regime_agreement": self.regime_agreement,
+                              "profile_factor": self.profile_factor, "one_sided": self.one_sided,
+                              "switch": self.switch}])
 
 
 def _diagram_points(frame: pd.DataFrame, converged_only: bool) -> pd.DataFrame:
@@ -411,25 +431,40 @@ def _diagram_points(frame: pd.DataFrame, converged_only: bool) -> pd.DataFrame:
     return frame.loc[sel].reset_index(drop=True)
 
 
+def _misfit(sq: np.ndarray, both: np.ndarray, weights: np.ndarray, need: float) -> np.ndarray:
+    """The extrema misfit per row of ``sq`` (n_D, n): the weighted mean of ``sq`` over the
+    points where ``both`` (n_D, n) holds; NaN where their weight is below ``need``."""
+    w = both * weights
+    total = w.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(total >= need, (np.where(both, sq, 0.0) * weights).sum(axis=1) / total, np.nan)
+    return out
+
+
 def fit_dc(frame: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateLaw], *,
            bounds: tuple[float, float] = (1e-3, 1.0), n_grid: int = 49, n_bootstrap: int = 400,
-           converged_only: bool = True, seed: int = 0,
+           converged_only: bool = True, seed: int = 0, min_share: float = 0.5,
            options: rsf.SolverOptions | None = None) -> DcFit:
-    r"""Fit D_c so that the RS diagram matches micro's σ_max and σ_min.
+    r"""Fit D_c so that RS's stick-slip extrema match micro's.
 
-    The residual is :math:`\sum_i (\sigma^{RS}_{max} - \sigma^{micro}_{max})^2 +
-    (\sigma^{RS}_{min} - \sigma^{micro}_{min})^2` over the micro points (steady rows have
-    σ_max = σ_min = σ, so a regime mismatch costs the RS amplitude).  Because D_c enters
-    only as k0·D_c, the problem is one-dimensional: the residual is scanned on a
+    The misfit at a D_c is the mean, over the points where both models are in stick-slip,
+    of :math:`(\sigma^{RS}_{max} - \sigma^{micro}_{max})^2 + (\sigma^{RS}_{min} -
+    \sigma^{micro}_{min})^2`.  Regime agreement is kept apart: RS is in stick-slip at (k0, V)
+    for :math:`k_0 D_c < W(V)` (``Dc_switch`` = W(V)/k0 of each point), so a point enters or
+    leaves the misfit at its switch, and the misfit is smooth between switches.  Because
+    D_c enters only as k0·D_c, the problem is one-dimensional: the misfit is scanned on a
     log-spaced grid of ``n_grid`` values in ``bounds`` (each point a handful of RS limit
-    cycles, ~1 ms), the best grid cell is refined by a bounded scalar minimisation, and
-    the uncertainty comes from the same grid: the profile interval and a bootstrap over
-    the points (resampled with replacement, optimum located on the grid by a parabola).
+    cycles, ~1 ms), the best grid value is refined by a bounded scalar minimisation within
+    its stretch between switches, and the uncertainty comes from the same grid: the profile
+    interval and a bootstrap over the points (resampled with replacement).  Only D_c at
+    which at least ``min_share`` of micro's stick-slip points are in stick-slip in RS too
+    are candidates (the misfit of a handful of points is no fit).
 
     Parameters
     ----------
     frame : DataFrame
-        Micro points with ``k0, V, regime, sigma_max, sigma_min`` (and ``converged``).
+        Micro points with ``k0, V, regime, sigma_max, sigma_min`` (and ``converged``);
+        steady points count for regime agreement only.
     law_for : callable
         k0 -> the RS steady-state law to use (e.g. ``fit.law`` of a :class:`SteadyLawFit`).
     bounds : (float, float)
@@ -440,77 +475,128 @@ def fit_dc(frame: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateLaw], 
         Skip micro points whose run did not converge (default True).
     seed : int
         Seed of the bootstrap's resampling.
+    min_share : float
+        In (0, 1]: the least share of micro's stick-slip points that must be in the misfit
+        at a candidate D_c (default 0.5; at least two points in any case).
     options : rsf.SolverOptions, optional
         For the RS limit cycles (:func:`rs_diagram`'s default).
 
     Returns
     -------
     DcFit
-        The optimum, its bootstrap error and profile interval, the residuals, and whether
-        the data bound D_c from one side only.
+        The optimum, its bootstrap error and profile interval, the residuals, the regime
+        agreement, and whether the data bound D_c from one side only.
 
     Raises
     ------
     ValueError
-        If ``bounds`` is not positive and increasing, ``n_grid`` < 7, ``frame`` lacks a
-        column, or fewer than 3 usable (steady or stick-slip, finite, converged) points
-        remain.
+        If ``bounds`` is not positive and increasing, ``n_grid`` < 7, ``min_share`` is not
+        in (0, 1], ``frame`` lacks a column, fewer than 3 usable (steady or stick-slip,
+        finite, converged) points remain or fewer than 2 of them are stick-slip, or no D_c
+        in ``bounds`` has ``min_share`` of them in stick-slip in RS.
     """
     lo, hi = positive("bounds[0]", bounds[0]), positive("bounds[1]", bounds[1])
     if not hi > lo:
         raise ValueError(f"bounds must be increasing, got {bounds!r}")
     if int(n_grid) < 7:
         raise ValueError(f"n_grid must be an integer >= 7, got {n_grid!r}")
+    if not 0.0 < float(min_share) <= 1.0:
+        raise ValueError(f"min_share must lie in (0, 1], got {min_share!r}")
     pts = _diagram_points(frame, converged_only)
     if len(pts) < 3:
         raise ValueError(f"need at least 3 usable micro points (steady or stick-slip, converged), got {len(pts)}")
-    target = np.concatenate([pts.sigma_max.to_numpy(float), pts.sigma_min.to_numpy(float)])
+    micro_ss = (pts.regime == "stick-slip").to_numpy()
+    if micro_ss.sum() < 2:
+        raise ValueError(f"need at least 2 usable micro stick-slip points, got {int(micro_ss.sum())}")
+    n = len(pts)
+    need = max(2.0, float(min_share) * float(micro_ss.sum()))
+    ones = np.ones(n)
+    smax, smin = pts.sigma_max.to_numpy(float), pts.sigma_min.to_numpy(float)
+    # regime switches: RS is unstable at (k0, V) for k0 Dc < W(V)
+    switches = np.array([float(law_for(k).weakening(np.array([v]))[0]) / k
+                         for k, v in zip(pts.k0.to_numpy(float), pts.V.to_numpy(float))])
 
-    def residuals(Dc: float) -> tuple[np.ndarray, pd.DataFrame]:
+    def at(Dc: float) -> tuple[np.ndarray, np.ndarray, pd.DataFrame]:
+        """(squared residual per point, both in stick-slip per point, RS's diagram)."""
         rs = rs_diagram(pts, law_for, Dc, options=options)
-        model = np.concatenate([rs.sigma_max.to_numpy(float), rs.sigma_min.to_numpy(float)])
-        return model - target, rs
+        sq = (rs.sigma_max.to_numpy(float) - smax) ** 2 + (rs.sigma_min.to_numpy(float) - smin) ** 2
+        return sq, micro_ss & (rs.regime.to_numpy() == "stick-slip"), rs
+
+    ss_pts = pts[micro_ss].reset_index(drop=True)
+    ones_ss = np.ones(len(ss_pts))
+
+    def misfit(Dc: float) -> float:
+        """The misfit alone (RS at micro's stick-slip points only)."""
+        rs = rs_diagram(ss_pts, law_for, Dc, options=options)
+        sq = (rs.sigma_max.to_numpy(float) - smax[micro_ss]) ** 2 + (rs.sigma_min.to_numpy(float) - smin[micro_ss]) ** 2
+        m = _misfit(sq[None], (rs.regime.to_numpy() == "stick-slip")[None], ones_ss, need)[0]
+        return float(m) if math.isfinite(m) else math.inf
 
     grid = np.geomspace(lo, hi, int(n_grid))
-    R = np.array([residuals(d)[0] for d in grid])            # (n_grid, 2 n)
-    n = len(pts)
-    per_point = R[:, :n] ** 2 + R[:, n:] ** 2                 # (n_grid, n)
-    rss_grid = per_point.sum(axis=1)
-    i = int(np.argmin(rss_grid))
-    a, b = math.log(grid[max(i - 1, 0)]), math.log(grid[min(i + 1, len(grid) - 1)])
-    opt = minimize_scalar(lambda g: float(np.sum(residuals(math.exp(g))[0] ** 2)), bounds=(a, b),
-                          method="bounded", options={"xatol": 1e-4})
-    Dc = float(math.exp(opt.x))
-    r_opt, rs_opt = residuals(Dc)
-    rss_min = float(r_opt @ r_opt)
+    runs = [at(d) for d in grid]
+    SQ = np.array([r[0] for r in runs])                         # (n_grid, n)
+    BOTH = np.array([r[1] for r in runs])
+    DIS = np.array([(r[2].regime.to_numpy() != pts.regime.to_numpy()).sum() for r in runs])
+    mis_grid = _misfit(SQ, BOTH, ones, need)
+    if not np.isfinite(mis_grid).any():
+        raise ValueError(f"no D_c in bounds {bounds!r} has {min_share:g} of micro's {int(micro_ss.sum())} "
+                         f"stick-slip points in stick-slip in RS too")
+    i = int(np.nanargmin(mis_grid))
+    # refine within the stretch between switches that holds the grid's best value
+    sw = np.sort(switches[np.isfinite(switches) & (switches > 0)])
+    a = float(grid[max(i - 1, 0)])
+    b = float(grid[min(i + 1, len(grid) - 1)])
+    below, above = sw[sw <= grid[i]], sw[sw > grid[i]]
+    if below.size:
+        a = max(a, float(below[-1]) * (1 + 1e-9))
+    if above.size:
+        b = min(b, float(above[0]) * (1 - 1e-9))
+    if b > a:
+        opt = minimize_scalar(lambda g: misfit(math.exp(g)), bounds=(math.log(a), math.log(b)), method="bounded",
+                              options={"xatol": 1e-5})
+        Dc = float(math.exp(opt.x)) if opt.fun <= mis_grid[i] else float(grid[i])
+    else:
+        Dc = float(grid[i])
+    sq_opt, both_opt, rs_opt = at(Dc)
+    mis_min = float(_misfit(sq_opt[None], both_opt[None], ones, need)[0])
+    n_ss = int(both_opt.sum())
     if i in (0, len(grid) - 1):
         log.warning("fit_dc: the optimum D_c = %.4g sits at the bound of %s", Dc, bounds)
-    # profile interval: where RSS(D_c) <= level, located by root finding on each side of the
-    # optimum (the grid alone cannot resolve a sharp minimum)
-    level = rss_min * (1.0 + 1.0 / max(n - 1, 1))
+    # profile interval: where the misfit stays within the factor of its minimum, located by
+    # bisection on each side of the optimum (the misfit steps at switches: bisection, not a root)
+    factor = 1.0 + 1.0 / max(n_ss - 1, 1)
+    level = mis_min * factor
     log_grid = np.log(grid)
-    rss_of = lambda g: float(np.sum(residuals(math.exp(g))[0] ** 2)) - level  # noqa: E731
     g_opt = math.log(Dc)
     ends = []
     for direction in (-1, +1):
         j = i
-        while 0 <= j < len(grid) and (rss_grid[j] <= level or (log_grid[j] - g_opt) * direction <= 0):
+        while 0 <= j < len(grid) and ((math.isfinite(mis_grid[j]) and mis_grid[j] <= level)
+                                       or (log_grid[j] - g_opt) * direction <= 0):
             j += direction
         if not 0 <= j < len(grid):
             ends.append(float(grid[0] if direction < 0 else grid[-1]))   # open at the search bound
             continue
-        a, b = sorted((g_opt, float(log_grid[j])))
-        try:
-            ends.append(math.exp(brentq(rss_of, a, b, xtol=1e-6)))
-        except ValueError:  # no sign change (level reached at the optimum itself)
-            ends.append(Dc)
+        inner, outer = g_opt, float(log_grid[j])
+        for _ in range(40):
+            mid = 0.5 * (inner + outer)
+            if misfit(math.exp(mid)) <= level:
+                inner = mid
+            else:
+                outer = mid
+            if abs(outer - inner) < 1e-4:
+                break
+        ends.append(math.exp(0.5 * (inner + outer)))
     profile_interval = (float(ends[0]), float(ends[1]))
     # bootstrap over points
     rng = np.random.default_rng(seed)
     boot = np.empty(int(n_bootstrap))
     for k in range(boot.size):
-        w = np.bincount(rng.integers(0, n, n), minlength=n)
-        boot[k] = math.exp(_parabolic_min(log_grid, per_point @ w))
+        w = np.bincount(rng.integers(0, n, n), minlength=n).astype(float)
+        y = _misfit(SQ, BOTH, w, need * w[micro_ss].sum() / micro_ss.sum())
+        boot[k] = math.exp(_parabolic_min(log_grid, np.where(np.isfinite(y), y, np.inf))) if np.isfinite(y).any() \
+            else math.nan
+    boot = boot[np.isfinite(boot)]
     if boot.size:
         q16, q84 = (float(x) for x in np.quantile(boot, [0.16, 0.84]))
     else:
@@ -522,33 +608,34 @@ def fit_dc(frame: pd.DataFrame, law_for: Callable[[float], rsf.SteadyStateLaw], 
     out["regime_rs"] = rs_opt.regime.to_numpy()
     out["sigma_max_rs"] = rs_opt.sigma_max.to_numpy()
     out["sigma_min_rs"] = rs_opt.sigma_min.to_numpy()
-    out["residual_max"] = r_opt[:n]
-    out["residual_min"] = r_opt[n:]
-    per_k0 = (out.assign(sq=out.residual_max ** 2 + out.residual_min ** 2)
+    out["residual_max"] = out.sigma_max_rs - out.sigma_max_micro
+    out["residual_min"] = out.sigma_min_rs - out.sigma_min_micro
+    out["in_misfit"] = both_opt
+    out["regime_agrees"] = out.regime_rs.to_numpy() == out.regime_micro.to_numpy()
+    out["Dc_switch"] = switches
+    used = out[out.in_misfit]
+    per_k0 = (used.assign(sq=used.residual_max ** 2 + used.residual_min ** 2)
               .groupby("k0").agg(n_points=("sq", "size"), sq=("sq", "sum")).reset_index())
     per_k0["rms"] = np.sqrt(per_k0.sq / (2 * per_k0.n_points))
     per_k0 = per_k0.drop(columns="sq")
-    agree = float(np.mean(out.regime_rs.to_numpy() == out.regime_micro.to_numpy()))
-    profile = pd.DataFrame({"Dc": grid, "rss": rss_grid, "rms": np.sqrt(rss_grid / (2 * n))})
-    # regime switches: RS is unstable at (k0, V) for k0 Dc < W(V)
-    switches = np.array([float(law_for(k).weakening(np.array([v]))[0]) / k
-                         for k, v in zip(pts.k0.to_numpy(float), pts.V.to_numpy(float))])
-    out["Dc_switch"] = switches
+    agree = float(np.mean(out.regime_agrees))
+    profile = pd.DataFrame({"Dc": grid, "rss": mis_grid * BOTH.sum(axis=1), "rms": np.sqrt(mis_grid / 2.0),
+                            "misfit": mis_grid, "n_stick_slip": BOTH.sum(axis=1), "n_disagree": DIS})
     one_sided, switch = "", math.nan
-    near = switches[np.isfinite(switches) & (switches > 0)]
-    if near.size:
-        j = int(np.argmin(np.abs(np.log(near / Dc))))
-        if abs(math.log(near[j] / Dc)) < 0.01:
-            switch = float(near[j])
+    if sw.size:
+        j = int(np.argmin(np.abs(np.log(sw / Dc))))
+        if abs(math.log(sw[j] / Dc)) < 0.01:
+            switch = float(sw[j])
             one_sided = "upper" if Dc <= switch else "lower"
     return DcFit(Dc=Dc, Dc_err=Dc_err, Dc_profile=profile_interval, Dc_bootstrap=(q16, q84),
-                 rms=math.sqrt(rss_min / (2 * n)), rms_per_k0=per_k0, profile=profile, points=out,
-                 n_points=n, regime_agreement=agree, bootstrap=boot, one_sided=one_sided, switch=switch)
+                 rms=math.sqrt(mis_min / 2.0), rms_per_k0=per_k0, profile=profile, points=out,
+                 n_points=n, regime_agreement=agree, bootstrap=boot, one_sided=one_sided, switch=switch,
+                 n_stick_slip=n_ss, n_disagree=int((~out.regime_agrees).sum()), profile_factor=factor)
 
 
 def _parabolic_min(x: np.ndarray, y: np.ndarray) -> float:
     i = int(np.argmin(y))
-    if i == 0 or i == len(y) - 1:
+    if i == 0 or i == len(y) - 1 or not (np.isfinite(y[i - 1]) and np.isfinite(y[i + 1])):
         return float(x[i])
     x0, x1, x2 = x[i - 1], x[i], x[i + 1]
     y0, y1, y2 = y[i - 1], y[i], y[i + 1]
@@ -558,6 +645,55 @@ def _parabolic_min(x: np.ndarray, y: np.ndarray) -> float:
     if a <= 0:
         return float(x1)
     return float(np.clip(-b / (2 * a), x0, x2))
+
+
+def dc_small_k0(frame: pd.DataFrame, law: rsf.HyperbolicLaw) -> float:
+    r"""D_c (a) at one k0 in the limit of small k0, in closed form.
+
+    For :math:`V \gg B` and :math:`k_0 D_c \ll A/B` RS's cycle at a = 0 (Eq. 10) is a stick
+    from :math:`\sigma_{min} = \mu_\infty` (the long slip empties the state) up to where the
+    stress catches the saturating strength, :math:`\sigma_{max} = \mu_\infty + (A - k_0 V D_c)/B`:
+    its extrema depend on :math:`k_0 V D_c` alone, and linearly.  Least squares of
+    :math:`\sigma_{max}` against micro's at its stick-slip points is then linear in D_c,
+
+    .. math:: D_c = \frac{\sum_i g_i h_i}{\sum_i h_i^2}, \quad g_i = \mu_\infty + A/B -
+              \sigma^{micro}_{max,i}, \quad h_i = k_0 V_i / B
+
+    (σ_min does not depend on D_c there).  With :math:`V_i = r_i V^c` and micro's
+    :math:`k_0 V^c` and cycles functions of the loading rate :math:`k_0 V` alone at small k0
+    (docs/reference/micro_transition.md, (L) and (V)), this D_c and D_c (b)
+    :math:`= W(V^c)/k_0 \to A/(k_0 V^c)` both tend to constants: their ratio
+    :math:`B \sum_i r_i g_i / (A \sum_i r_i^2)` is constant at small k0.
+
+    Parameters
+    ----------
+    frame : DataFrame
+        Micro points at one k0 with ``k0, V, regime, sigma_max``; only stick-slip rows are used.
+    law : rsf.HyperbolicLaw
+        The fitted Eq. (10) at that k0.
+
+    Returns
+    -------
+    float
+        The closed-form D_c; NaN without stick-slip points.
+
+    Examples
+    --------
+    >>> import pandas as pd, rsf
+    >>> from compare.fits import dc_small_k0
+    >>> law = rsf.HyperbolicLaw(A=0.0075, B=0.083, mu_inf=0.9)
+    >>> k0, Dc = 1e-4, 0.085
+    >>> V = [200.0, 400.0]
+    >>> smax = [rsf.limit_cycle(rsf.SpringSlider(law=law, k0=k0, Dc=Dc), v).sigma_max for v in V]
+    >>> round(dc_small_k0(pd.DataFrame({"k0": k0, "V": V, "regime": "stick-slip", "sigma_max": smax}), law), 5)
+    0.085
+    """
+    ss = frame[(frame.regime == "stick-slip") & np.isfinite(frame.sigma_max)]
+    if not len(ss):
+        return math.nan
+    g = law.mu_inf + law.A / law.B - ss.sigma_max.to_numpy(float)
+    h = ss.k0.to_numpy(float) * ss.V.to_numpy(float) / law.B
+    return float(g @ h / (h @ h))
 
 
 # ============================================================================ D_c from V^c

@@ -29,6 +29,9 @@ PAPER_K0 = (0.3, 0.1, 0.01, 0.001, 0.0001)
 
 #: (k1, k2) of the paper's Fig. 5, bottom to top.
 PAPER_SETS = ((0.0, 1.0), (0.1, 0.9), (0.5, 0.5), (0.9, 0.1))
+#: V / V^c of the default stick-slip points of D_c (a), the same five at every k0: enough
+#: cycles to fix D_c (a) at each k0 alone (``dc_per_k0``), spread over micro's stick-slip side.
+DC_RATIOS = (0.15, 0.25, 0.4, 0.55, 0.7)
 
 
 def _velocity_ratios(name: str, values) -> tuple[float, ...]:
@@ -80,9 +83,9 @@ class Settings:
     reference_k0, reference_V : a stiffness k0 >= k2, at which micro slides steadily at
         every V; its branch on ``reference_V`` reaches V ~ B and pins the shape of Eq. (10).
     fp_points : (k0, V / V^c) of the stick-slip points that the D_c fit matches (with
-        exact steady points at ``steady_ratios`` V^c at the same k0): by default two at
-        each of the paper's five k0, so that D_c (a) is fitted at every k0 and also per k0
-        (``dc_per_k0``); ``fp_k0`` is the set of their k0 (the names are older than the
+        exact steady points at ``steady_ratios`` V^c at the same k0): by default five
+        (``DC_RATIOS``) at each of the paper's five k0, so that D_c (a) is fitted at every k0
+        and also at each k0 alone from five cycles (``dc_per_k0``); ``fp_k0`` is the set of their k0 (the names are older than the
         cohort method: the points are solved by ``cycle_method``).  With ``cycle_method="fp"``, the FP's cost grows near V^c (a
         cycle a few bins high settles slowly), at k0 = 0.3 faster than at 0.1.
     shown_points : (k0, V / V^c) of stick-slip points drawn on the diagram (by
@@ -136,9 +139,7 @@ class Settings:
     unstable_from: float = 0.02
     reference_k0: float = 1.0
     reference_V: tuple[float, ...] = _geom(1e-3, 1e3, 25)
-    fp_points: tuple[tuple[float, float], ...] = ((0.3, 0.15), (0.3, 0.4), (0.1, 0.15), (0.1, 0.4), (0.1, 0.55),
-                                                  (0.1, 0.7), (0.01, 0.4), (0.01, 0.7), (0.001, 0.4), (0.001, 0.7),
-                                                  (0.0001, 0.4), (0.0001, 0.7))
+    fp_points: tuple[tuple[float, float], ...] = tuple((k0, r) for k0 in PAPER_K0 for r in DC_RATIOS)
     shown_points: tuple[tuple[float, float], ...] = ()
     cycle_method: str = "cohort"
     cycle_rtol: float = 1e-3

@@ -10,7 +10,13 @@ from __future__ import annotations
 import math
 from typing import Any, Sequence
 
-__all__ = ["summary", "fmt", "pct"]
+from .tasks import SteadyTask
+
+__all__ = ["summary", "fmt", "pct", "STEADY_TOL"]
+
+#: The tolerance of micro's exact steady branch in a report (:class:`SteadyTask`'s ``tol``),
+#: quoted by the summary from the task, not copied.
+STEADY_TOL: float = SteadyTask.tol
 
 
 def fmt(x: Any, digits: int = 4) -> str:
@@ -33,7 +39,8 @@ def _warnings(ctx, t) -> list[str]:
     b = t.get("micro_branch")
     if b is not None and (~b.converged.astype(bool)).any():
         bad = b[~b.converged.astype(bool)]
-        notes.append(f"{len(bad)} exact steady points did not reach the tolerance 1e-11 (largest sigma_error "
+        notes.append(f"{len(bad)} exact steady points did not reach the tolerance {STEADY_TOL:g} (largest "
+                     f"sigma_error "
                      f"{fmt(bad.sigma_error.max(), 2)}, branching_error {fmt(bad.branching_error.max(), 2)}; "
                      f"V = {fmt(bad.V.min(), 3)} to {fmt(bad.V.max(), 3)}).")
     for name in ("micro_points", "hopf_points"):

@@ -96,11 +96,14 @@ def _critical_table(ctx: Context, part: Part) -> pd.DataFrame:
     part.tables["critical_velocity"] = frame
     if ctx.Dc_given is None:
         # what D_c (b) implies for the extrema that D_c (a) was fitted to
+        # (the same misfit as D_c (a)'s: the extrema where both models are in stick-slip)
         pts = ctx.dc_fit.points
         rs = fits.rs_diagram(pts, ctx.law_for, dcv.Dc)
-        r = np.concatenate([rs.sigma_max.to_numpy() - pts.sigma_max_micro.to_numpy(),
-                            rs.sigma_min.to_numpy() - pts.sigma_min_micro.to_numpy()])
-        part.values["Dc_vc_extrema_rms"] = float(np.sqrt(np.mean(r * r)))
+        both = (pts.regime_micro.to_numpy() == "stick-slip") & (rs.regime.to_numpy() == "stick-slip")
+        r = np.concatenate([(rs.sigma_max.to_numpy() - pts.sigma_max_micro.to_numpy())[both],
+                            (rs.sigma_min.to_numpy() - pts.sigma_min_micro.to_numpy())[both]])
+        part.values["Dc_vc_extrema_rms"] = float(np.sqrt(np.mean(r * r))) if r.size else math.nan
+        part.values["Dc_vc_n_stick_slip"] = int(both.sum())
         part.values["Dc_vc_regime_agreement"] = float(np.mean(rs.regime.to_numpy() == pts.regime_micro.to_numpy()))
     return frame
 
@@ -122,8 +125,12 @@ def summary(ctx: Context, part: Part) -> list[str]:
 
 
 def _critical(t) -> list[str]:
+    crit = t["critical_velocity"]
+    rel = (crit.Vc_micro_err / crit.Vc_micro).to_numpy(float)
+    rel = rel[np.isfinite(rel)]
+    err = f"relative error at most {fmt(float(rel.max()), 2)}" if rel.size else "error not known"
     lines = ["## Critical velocity per k0", "",
-             "Micro: exact (the root of branching ratio = 1; error below 1e-9 relative); RS: linear stability "
+             f"Micro: exact (the root of branching ratio = 1; {err}); RS: linear stability "
              "with the fitted law and each D_c.", "",
              "| k0 | V^c micro | small-k0 asymptote | V^c RS, D_c (a) | V^c RS, D_c (b) | V^c RS (paper's law, D_c) |",
              "|---|---|---|---|---|---|"]
@@ -147,12 +154,14 @@ def _dc(ctx: Context, t, v) -> list[str]:
     crit = t.get("critical_velocity")
     if "Dc" in v:
         lo, hi = v["Dc_profile"]
+        factor = v["Dc_profile_factor"]
+        profile = f"misfit within a factor {factor:.3g} of its minimum: [{fmt(lo, 3)}, {fmt(hi, 3)}]"
         if v.get("Dc_one_sided"):
             bound = "≤" if v["Dc_one_sided"] == "upper" else "≥"
-            interval = (f"one-sided: D_c {bound} {fmt(v['Dc_switch'], 4)} (a regime switch of the RS diagram: "
-                        f"the optimum sits on it); profile [{fmt(lo, 3)}, {fmt(hi, 3)}]")
+            interval = (f"one-sided: D_c {bound} {fmt(v['Dc_switch'], 4)} (the optimum sits on a point's regime "
+                        f"switch); {profile}")
         else:
-            interval = f"± {fmt(v['Dc_err'], 2)} (bootstrap 16-84 %); profile [{fmt(lo, 3)}, {fmt(hi, 3)}]"
+            interval = f"± {fmt(v['Dc_err'], 2)} (bootstrap 16-84 %); {profile}"
         implied = ""
         if crit is not None:
             c = crit[np.isfinite(crit.rel_diff_rs)]
@@ -161,19 +170,24 @@ def _dc(ctx: Context, t, v) -> list[str]:
             none = crit[~np.isfinite(crit.Vc_rs)]
             if len(none):
                 implied += "; no RS stick-slip at all at k0 = " + ", ".join(f"{k:g}" for k in none.k0)
-        rows.append(f"| (a) stick-slip extrema | {fmt(v['Dc'])} | {interval} | sigma_max, sigma_min of "
-                    f"{int(t['dc_fit'].n_points.iloc[0])} micro points at k0 = {', '.join(f'{k:g}' for k in s.fp_k0)} "
-                    f"(rms {fmt(v['Dc_rms'], 3)}, regime agreement {100 * v['regime_agreement']:.0f} %) | {implied} |")
+        pts = t["dc_points"]
+        n_cyc = int((pts.regime_micro == "stick-slip").sum())
+        rows.append(f"| (a) stick-slip extrema | {fmt(v['Dc'])} | {interval} | sigma_max, sigma_min where both models "
+                    f"are in stick-slip: {v['Dc_n_stick_slip']} of micro's {n_cyc} cycles at k0 = "
+                    f"{', '.join(f'{k:g}' for k in s.fp_k0)} (rms {fmt(v['Dc_rms'], 3)}) | {implied} |")
     elif ctx.Dc_given is not None:
         rows.append(f"| given | {ctx.Dc_given:g} | | | |")
     implied_b = ""
     if "Dc_vc_extrema_rms" in v:
-        implied_b = (f"rms of the extrema {fmt(v['Dc_vc_extrema_rms'], 3)} (against {fmt(v['Dc_rms'], 3)} at (a)), "
-                     f"regime agreement {100 * v['Dc_vc_regime_agreement']:.0f} %")
+        implied_b = (f"extrema rms {fmt(v['Dc_vc_extrema_rms'], 3)} over the {v['Dc_vc_n_stick_slip']} points in "
+                     f"stick-slip in both (against {fmt(v['Dc_rms'], 3)} at (a)); regime agreement "
+                     f"{100 * v['Dc_vc_regime_agreement']:.0f} %")
     rows.append(f"| (b) V^c matching | {fmt(dcv.Dc)} | ± {fmt(dcv.Dc_err, 2)} (standard error); per-k0 values "
                 f"{fmt(dcv.Dc_range[0], 3)} to {fmt(dcv.Dc_range[1], 3)} | micro's exact V^c at "
                 f"{len(dcv.per_k0)} k0 (rms {100 * dcv.rms_log:.1f} % in V^c) | {implied_b} |")
     lines += rows + [""]
+    if "Dc" in v:
+        lines += _regimes(t, v)
     per = dcv.per_k0
     lines += ["Per k0, k0 D_c = W(V^c) = −V dmu_ss/dV at micro's exact V^c, with the fitted law's slope and with "
               "micro's own:", "", "| k0 | V^c micro | D_c (law) | D_c (micro's slope) |", "|---|---|---|---|"]
@@ -182,40 +196,72 @@ def _dc(ctx: Context, t, v) -> list[str]:
     lines.append("")
     if "Dc" in v:
         a, b = v["Dc"], dcv.Dc
+        lo_a, hi_a = v["Dc_profile"]
         lo_b, hi_b = dcv.Dc_range
-        agree = lo_b <= a <= hi_b
-        if agree and abs(math.log(a / b)) < 0.1:
-            lines.append(f"**The two D_c agree**: (a) {fmt(a)} lies within the per-k0 range of (b) and within 10 % "
-                         f"of it.")
+        if lo_a <= hi_b and lo_b <= hi_a:
+            lines.append(f"**The two D_c overlap**: (a) = {fmt(a)} with its interval [{fmt(lo_a, 3)}, {fmt(hi_a, 3)}] "
+                         f"meets (b)'s per-k0 range [{fmt(lo_b, 3)}, {fmt(hi_b, 3)}] ((a)/(b) = {fmt(a / b, 3)}).")
         else:
-            lines.append(f"**The two D_c disagree**: (a) = {fmt(a)} from the stick-slip extrema, (b) = {fmt(b)} "
-                         f"from V^c ({pct(a / b - 1)}); with (a) RS misplaces micro's V^c by up to "
-                         f"{pct(float(crit.rel_diff_rs.abs().max()))}, and no single D_c reproduces V^c at every k0 "
-                         f"(per-k0 values {fmt(lo_b, 3)} to {fmt(hi_b, 3)}): one RS law with one D_c cannot "
-                         f"carry both micro's cycle amplitudes and its stability boundary.")
+            lines.append(f"**The two D_c disagree**: (a) = {fmt(a)} from the stick-slip extrema, interval "
+                         f"[{fmt(lo_a, 3)}, {fmt(hi_a, 3)}], (b) = {fmt(b)} from V^c, per-k0 range "
+                         f"[{fmt(lo_b, 3)}, {fmt(hi_b, 3)}]; with (a) RS misplaces micro's V^c by up to "
+                         f"{pct(float(crit.rel_diff_rs.abs().max()))}: one RS law with one D_c cannot carry both "
+                         "micro's cycle amplitudes and its stability boundary.")
         lines.append("")
     per_a = t.get("dc_per_k0")
     if per_a is not None and len(per_a) > 1:
-        lines += ["", "D_c (a) fitted at each k0 alone (its stick-slip extrema and steady points) beside D_c (b) at "
-                  "that k0:", "", "| k0 | points | D_c (a) alone | profile | rms | D_c (b) | (a)/(b) |",
-                  "|---|---|---|---|---|---|---|"]
-        for _, r in per_a.iterrows():
-            side = f" ({r.one_sided} bound)" if isinstance(r.one_sided, str) and r.one_sided else ""
-            lines.append(f"| {r.k0:g} | {int(r.n_points)} | {fmt(r.Dc_a)}{side} | [{fmt(r.Dc_a_lo, 3)}, "
-                         f"{fmt(r.Dc_a_hi, 3)}] | {fmt(r.rms_a, 3)} | {fmt(r.Dc_b)} | {fmt(r.ratio_a_b, 3)} |")
-        a_lo, a_hi = float(per_a.Dc_a.min()), float(per_a.Dc_a.max())
-        b_lo, b_hi = float(per_a.Dc_b.min()), float(per_a.Dc_b.max())
-        lines += ["", f"Across the {len(per_a)} k0 the per-k0 optimum of (a) spans {fmt(a_lo, 3)} to {fmt(a_hi, 3)} "
-                  f"(a factor {a_hi / a_lo:.2g}) and (b) spans {fmt(b_lo, 3)} to {fmt(b_hi, 3)} (a factor "
-                  f"{b_hi / b_lo:.2g}); their ratio (a)/(b) runs from {fmt(float(per_a.ratio_a_b.min()), 3)} to "
-                  f"{fmt(float(per_a.ratio_a_b.max()), 3)}. The two ask different things of the law's shape: (b) "
-                  "only its slope at micro's V^c (k0 D_c = W(V^c), one number per k0), (a) the whole weakening "
-                  "between the velocities a cycle visits (its extrema are set by how far the law falls from "
-                  "sigma_max to the slip's velocities): a ratio (a)/(b) that moves with k0 means the fitted law's "
-                  "weakening away from V^c does not scale like its slope at V^c, so no single D_c, and no "
-                  "per-k0 D_c either, lets one RS law carry both.", ""]
-    lines.append("Figure `critical_velocity.png`: V^c(k0) of micro (exact) and of RS with each D_c.")
+        lines += _per_k0(per_a)
+    lines.append("Figure `critical_velocity.png`: V^c(k0) of micro (exact) and of RS with each D_c; `dc_profile.png`: "
+                 "the misfit against D_c, all k0 and each alone, with every point's regime switch (tables "
+                 "`dc_profile`, `dc_profile_per_k0`).")
     lines.append("")
+    return lines
+
+
+def _regimes(t, v) -> list[str]:
+    """Regime agreement at D_c (a), apart from the misfit: the points whose regimes differ."""
+    pts = t["dc_points"]
+    bad = pts[~pts.regime_agrees.astype(bool)]
+    head = (f"Regime agreement at D_c (a), apart from the misfit: {len(pts) - len(bad)} of {len(pts)} micro points "
+            f"(stick-slip and steady) have RS's regime")
+    if not len(bad):
+        return [head + ".", ""]
+    vc = t["critical_velocity"].set_index("k0").Vc_micro
+    lines = [head + "; these do not (RS is in stick-slip at a point for D_c below its switch W(V)/k0):", "",
+             "| k0 | V / V^c | micro | RS | switch W(V)/k0 |", "|---|---|---|---|---|"]
+    for _, r in bad.iterrows():
+        lines.append(f"| {r.k0:g} | {fmt(r.V / float(vc.get(r.k0, math.nan)), 3)} | {r.regime_micro} | "
+                     f"{r.regime_rs} | {fmt(r.Dc_switch, 4)} |")
+    return lines + [""]
+
+
+def _per_k0(per_a) -> list[str]:
+    """D_c (a) at each k0 alone, with its interval, and the (a)/(b) ratio explained."""
+    lines = ["D_c (a) fitted at each k0 alone beside D_c (b) at that k0 (`dc_per_k0.csv`); the interval is the D_c "
+             "range where that k0's misfit stays within the stated factor, 1 + 1/(n − 1) for its n points in the "
+             "misfit, of its minimum:", "",
+             "| k0 | micro cycles | in the misfit | D_c (a) alone | interval | factor | rms | regime disagreements | "
+             "D_c (b) | (a)/(b) | small-k0 closed form of (a) | its ratio to (b) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for _, r in per_a.iterrows():
+        side = f" ({r.one_sided} bound)" if isinstance(r.one_sided, str) and r.one_sided else ""
+        lines.append(f"| {r.k0:g} | {int(r.n_cycles)} | {int(r.n_stick_slip)} | {fmt(r.Dc_a)}{side} | "
+                     f"[{fmt(r.Dc_a_lo, 3)}, {fmt(r.Dc_a_hi, 3)}] | {r.profile_factor:.3g} | {fmt(r.rms_a, 3)} | "
+                     f"{int(r.n_disagree)} | {fmt(r.Dc_b)} | {fmt(r.ratio_a_b, 3)} | {fmt(r.Dc_a_small_k0)} | "
+                     f"{fmt(r.ratio_small_k0, 3)} |")
+    small = per_a[per_a.k0 <= per_a.k0.min() * 100]       # the two decades above the smallest k0
+    big = per_a[~per_a.index.isin(small.index)]
+    lines += ["", "Why (a)/(b) is constant at small k0 (derived; `compare.fits.dc_small_k0`): there RS's cycle at "
+              "a = 0 runs from sigma_min = mu_inf to sigma_max = mu_inf + (A − k0 V D_c)/B, a function of k0 V D_c "
+              "alone, while micro's cycles and k0 V^c depend on the loading rate k0 V alone "
+              "(docs/reference/micro_transition.md, (L) and (V)); at fixed V/V^c both D_c (a) and D_c (b) = "
+              "W(V^c)/k0 ≈ A/(k0 V^c) then tend to constants. Measured: (a)/(b) = "
+              + ", ".join(f"{fmt(r.ratio_a_b, 3)}" for _, r in small.iterrows())
+              + f" at k0 = {', '.join(f'{k:g}' for k in small.k0)} (closed form "
+              + ", ".join(f"{fmt(r.ratio_small_k0, 3)}" for _, r in small.iterrows()) + ")"
+              + ("; at k0 = " + ", ".join(f"{r.k0:g}: {fmt(r.ratio_a_b, 3)}" for _, r in big.iterrows())
+                 + ", where the slip no longer empties the state and V is not large against B" if len(big) else "")
+              + ".", ""]
     return lines
 
 

@@ -98,13 +98,18 @@ def draw(ctx: Context, part: Part, out) -> dict[str, Path]:
     return {"phase": figures.phase(t, v, figures.target(out, "phase.png"))}
 
 
+#: The k0 at which the phase table compares micro's V^c with RS's (a), in every set.
+RATIO_K0 = 1e-3
+
+
 def summary(ctx: Context, part: Part) -> list[str]:
     t = part.tables
     lines = ["## Phase diagram (Fig. 5)", "",
              "Micro's exact V^c(k0) at each (k1, k2) set (points), its small-k0 asymptote "
              "V^c ≈ k2 γ⟨z²⟩/(2 zbar k0) and its end at k0 = k2; RS with Eq. (10) fitted to each set's exact "
              "reference branch and each D_c:", "",
-             "| k1 | k2 | micro k0 points | A | B | RS k0_max = A/(4 B D_c) (a), (b) | micro V^c / RS V^c (a) at k0 = 1e-3 |",
+             f"| k1 | k2 | micro k0 points | A | B | RS k0_max = A/(4 B D_c) (a), (b) | micro V^c / RS V^c (a) at "
+             f"k0 = {RATIO_K0:g} |",
              "|---|---|---|---|---|---|---|"]
     pm, rs = t["phase_micro"], t["phase_rs"]
     for _, r in t["phase_laws"].iterrows():
@@ -112,8 +117,8 @@ def summary(ctx: Context, part: Part) -> list[str]:
         x = rs[np.isclose(rs.k1, r.k1) & np.isclose(rs.k2, r.k2)]
         ratio = math.nan
         if len(m) and len(x):
-            ratio = float(np.exp(np.interp(math.log(1e-3), np.log(m.k0), np.log(np.clip(m.Vc, 1e-300, None))) -
-                                 np.interp(math.log(1e-3), np.log(x.k0), np.log(np.clip(x.Vc, 1e-300, None)))))
+            ratio = float(np.exp(np.interp(math.log(RATIO_K0), np.log(m.k0), np.log(np.clip(m.Vc, 1e-300, None))) -
+                                 np.interp(math.log(RATIO_K0), np.log(x.k0), np.log(np.clip(x.Vc, 1e-300, None)))))
         lines.append(f"| {r.k1:g} | {r.k2:g} | {len(m)} | {fmt(r.A)} | {fmt(r.B)} | {fmt(r.k0_max_rs, 3)}, "
                      f"{fmt(r.k0_max_rs_dc_vc, 3)} | {fmt(ratio, 3)} |")
     lines.append("")

@@ -5,20 +5,26 @@ the unstable mode against d = (V^c - V)/V^c (micro's from the shared exact branc
 a = 0 from :func:`rsf.transition_spectrum`).  Both models' stick-slip amplitude against d,
 each against its own exact V^c: micro's default method (the cohort method's cycles, with
 their error where it is known) and the N-block at two sizes; RS's cycles with the
-asymptote derived from its stick-slip map (:func:`rsf.stick_slip_normal_form`; micro has
-none derived yet).  One power law per method (:func:`compare.fits.transition_fits`: its
-exponent, confidence interval and the range of d it rests on; only points whose error is
-known), :func:`compare.fits.classify_transition`'s evidence, and the verdict as one
-paragraph (:func:`verdict`).
+asymptote derived from its stick-slip map (:func:`rsf.stick_slip_normal_form`); micro's
+total-shock law derived from its reset model, (R) of docs/reference/micro_transition.md,
+where it holds (d >~ k0/k2), and the measured memory factor and linear law of the validation
+record, read from the package's data file (:func:`measured_transition`).  One power law per
+method (:func:`compare.fits.transition_fits`: its exponent, confidence interval and the range
+of d it rests on; only points whose error is known), :func:`compare.fits.classify_transition`'s
+evidence, and the verdict as one paragraph of at most :data:`VERDICT_WORDS` words
+(:func:`verdict`).
 """
 from __future__ import annotations
 
 import logging
 import math
+from functools import lru_cache
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from scipy.optimize import brentq
 
 import micro
 import rsf
@@ -42,9 +48,94 @@ log = logging.getLogger(__name__)
 RS_SPECTRUM_D = (1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 0.03, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9)
 
 #: The columns of ``hopf_points`` (the first thirteen are read by other scripts: keep them).
+#: ``d_r`` and ``reset_amplitude``: micro's distance to the end of its total-shock branch and
+#: the reset model's amplitude (R) there (:func:`reset_amplitude`).
 POINT_COLUMNS = ["model", "method", "resolution", "k0", "V", "Vc", "d", "regime", "sigma_max", "sigma_min",
                  "amplitude", "amplitude_stderr", "period", "amplitude_error_kind", "discretisation_error",
-                 "sigma_stderr", "converged", "asymptote"]
+                 "sigma_stderr", "converged", "asymptote", "d_r", "reset_amplitude"]
+
+#: The measured constants of micro's transition the report draws, with their provenance in
+#: the file's header (the validation study's command and date).
+MEASURED_FILE = "micro_transition_measured.csv"
+
+
+@lru_cache(maxsize=1)
+def measured_transition() -> pd.DataFrame:
+    """The measured constants of micro's transition shipped with the package
+    (``compare/data/micro_transition_measured.csv``; its header names the study's command,
+    date and page): ``quantity`` is ``'memory_factor'`` (T/T_r, the loading time over the
+    reset model's, against ``d_r``) or ``'amplitude_over_d'`` (the constant A/d of the
+    measured linear law deep in the partial-shock regime), at ``k0, d, d_r``."""
+    with resources.files("compare").joinpath("data", MEASURED_FILE).open("r", encoding="utf-8") as fh:
+        return pd.read_csv(fh, comment="#")
+
+
+def reset_amplitude(model: micro.Model, V) -> np.ndarray:
+    r"""The amplitude of micro's reset model with total shocks, (R) of
+    docs/reference/micro_transition.md §3.1:
+    :math:`A_r = k_2\bar z\,q\,\tau_r(q)` with :math:`q = V/V^c_r = 1 - d_r`,
+    :math:`V^c_r = k_2\gamma\bar z/k_0` (:func:`micro.vc_small_k0`) and :math:`\tau_r` the root
+    of :math:`(1 - e^{-\tau})/\tau = q`; :math:`A_r = 2k_2\bar z\,d_r(1 - d_r/3 + O(d_r^2))`.
+    Derived for exponential jumps of mean ``zbar`` (``jumps.mean_residual``); NaN where
+    :math:`q \notin (0, 1)`.  Micro's cycle is :math:`c_m A_r` while shocks are total
+    (d >~ k0/k2), with the memory factor :math:`c_m` measured, not derived.
+
+    Examples
+    --------
+    >>> import micro
+    >>> from compare.scenarios.transition import reset_amplitude
+    >>> m = micro.Model(k0=0.001)
+    >>> V = 0.99 * micro.vc_small_k0(m)          # d_r = 0.01
+    >>> a = float(reset_amplitude(m, V))
+    >>> round(a / (2 * m.k2 * 0.1 * 0.01 * (1 - 0.01 / 3)), 4)
+    1.0
+    """
+    zbar = model.jumps.mean_residual
+    q = np.atleast_1d(np.asarray(V, dtype=float)) / micro.vc_small_k0(model)
+    out = np.full(q.shape, math.nan)
+    for i, qi in enumerate(q):
+        if 0.0 < qi < 1.0:
+            tau = brentq(lambda t: -math.expm1(-t) / t - qi, 1e-12, 2.0 / qi + 50.0, xtol=1e-14, rtol=1e-13)
+            out[i] = model.k2 * zbar * qi * tau
+    return out if np.ndim(V) else out[0]
+
+
+def micro_laws(model: micro.Model, vc: float, d_max: float, n: int = 60) -> pd.DataFrame:
+    """Micro's amplitude laws on a d grid, for ``hopf.png`` and the table ``hopf_micro_laws``:
+    the reset model's total-shock law (R) from d = k0/k2 (where shocks become total) to
+    ``d_max`` (``law = 'reset (R), derived'``), the same times the memory factor measured
+    at small k0 (interpolated in d_r over its measured range only; ``'reset (R) x measured
+    memory factor'``), and the measured linear law A = (A/d) d at this k0 over the d it was
+    measured at, if the package's data has it (``'linear, measured'``).  Columns ``law, d,
+    d_r, amplitude, source``."""
+    k0 = model.k0
+    vcr = micro.vc_small_k0(model)
+    rows = []
+    d0 = k0 / model.k2
+    if vc > 0 and d_max > d0:
+        d = np.geomspace(d0, d_max, n)
+        V = vc * (1.0 - d)
+        d_r = 1.0 - V / vcr
+        a_r = reset_amplitude(model, V)
+        rows.append(pd.DataFrame({"law": "reset (R), derived", "d": d, "d_r": d_r, "amplitude": a_r,
+                                  "source": "docs/reference/micro_transition.md (R)"}))
+        m = measured_transition()
+        cm = m[m.quantity == "memory_factor"].groupby("d_r", as_index=False).value.mean().sort_values("d_r")
+        inside = (d_r >= cm.d_r.min()) & (d_r <= cm.d_r.max())
+        if inside.any():
+            c = np.interp(np.log(d_r[inside]), np.log(cm.d_r.to_numpy()), cm.value.to_numpy())
+            rows.append(pd.DataFrame({"law": "reset (R) x measured memory factor", "d": d[inside],
+                                      "d_r": d_r[inside], "amplitude": c * a_r[inside],
+                                      "source": f"compare/data/{MEASURED_FILE}"}))
+    lin = measured_transition()
+    lin = lin[(lin.quantity == "amplitude_over_d") & np.isclose(lin.k0, k0, rtol=1e-9)]
+    if len(lin) and vc > 0:
+        d = np.geomspace(float(lin.d.min()), float(lin.d.max()), 10)
+        rows.append(pd.DataFrame({"law": "linear, measured", "d": d, "d_r": 1.0 - vc * (1.0 - d) / vcr,
+                                  "amplitude": float(lin.value.mean()) * d,
+                                  "source": f"compare/data/{MEASURED_FILE}"}))
+    return pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(columns=["law", "d", "d_r", "amplitude",
+                                                                               "source"])
 
 #: The order of ``hopf_fit``'s rows: RS, then micro's default (the cohort), the N-block by N, the FP.
 _ORDER = {("RS", "CVODE"): 0, ("micro", "cohort"): 1, ("micro", "N-block"): 2, ("micro", "fp"): 3, ("micro", "FP"): 3}
@@ -134,6 +225,8 @@ def run(ctx: Context) -> Part:
                                                                   micro_pts.sigma_min_stderr)[nb_rows]
         micro_pts.loc[nb_rows, "amplitude_error_kind"] = np.where(
             np.isfinite(micro_pts.amplitude_stderr[nb_rows].astype(float)), "standard error", "not known")
+        micro_pts["d_r"] = 1.0 - micro_pts.V / micro.vc_small_k0(ctx.model(k0))
+        micro_pts["reset_amplitude"] = reset_amplitude(ctx.model(k0), micro_pts.V.to_numpy(float))
     model = rsf.SpringSlider(law=ctx.law_for(k0), k0=k0, Dc=ctx.Dc)
     rs = rs_hopf(model, s.rs_hopf_distances)
     rs["model"], rs["k0"], rs["method"], rs["resolution"] = "RS", k0, "CVODE", math.nan
@@ -157,6 +250,8 @@ def run(ctx: Context) -> Part:
     points["fitted"] = ((points.regime == "stick-slip") & (points.amplitude > 0)
                         & (points.amplitude_error_kind != "not known"))
     part.tables["hopf_points"] = points
+    shown = points.d[(points.model == "micro") & (points.regime == "stick-slip") & (points.amplitude > 0)]
+    part.tables["hopf_micro_laws"] = micro_laws(ctx.model(k0), vc, float(shown.max()) if len(shown) else 0.0)
     part.tables["hopf_fit"] = _fit_table(points)
     b = ctx.branch
     spec = b[(b.role == "branch") & np.isclose(b.k0, k0) & (b.V < vc)].sort_values("V")
@@ -173,7 +268,8 @@ def _fit_table(points: pd.DataFrame) -> pd.DataFrame:
     """``hopf_fit``: one row per method (:func:`compare.fits.transition_fits`), in the
     order RS, micro's cohort, the N-block by N, the FP; with each model's V^c and its
     asymptote (RS: derived, and the simulated amplitude over it at the smallest fitted d;
-    micro: none derived yet)."""
+    micro: the reset model's total-shock law, derived where shocks are total, off by a
+    measured memory factor; ``hopf_micro_laws``)."""
     fit = fits.transition_fits(points)
     if not len(fit):
         return fit
@@ -191,7 +287,8 @@ def _fit_table(points: pd.DataFrame) -> pd.DataFrame:
             text.append("c0 d^(1/2) (1 + c2 d), derived")
         else:
             ratio.append(math.nan)
-            text.append("none derived" if r.model == "micro" else "")
+            text.append("reset model (R) derived for d >~ k0/k2, times a measured memory factor"
+                        if r.model == "micro" else "")
     fit["asymptote"], fit["asymptote_ratio_at_d_min"] = text, ratio
     return fit
 
@@ -219,90 +316,80 @@ def _beta(r) -> str:
             f"d = {fmt(r.d_min, 2)} to {fmt(r.d_max, 2)}")
 
 
+#: The most words :func:`verdict` may take: a paragraph a physicist can quote.
+VERDICT_WORDS = 150
+
+
+def memory_ratio(points: pd.DataFrame, k0: float, k2: float) -> tuple[float, float, int]:
+    """(smallest, largest, count) of micro's cohort amplitude over the reset model's (R)
+    at the fitted cohort points where shocks are total (d >= k0/k2): the memory factor
+    at this k0, as this run measures it (NaN, NaN, 0 if none)."""
+    if not len(points) or "reset_amplitude" not in points:
+        return math.nan, math.nan, 0
+    c = points[(points.model == "micro") & (points.method == "cohort") & points.fitted.astype(bool)
+               & (points.d >= k0 / k2)]
+    r = (c.amplitude / c.reset_amplitude).to_numpy(float)
+    r = r[np.isfinite(r)]
+    return (float(r.min()), float(r.max()), int(r.size)) if r.size else (math.nan, math.nan, 0)
+
+
 def verdict(s: Settings, t: dict[str, pd.DataFrame], v: dict) -> str:
-    """The transition's verdict, one paragraph: how each model loses stability (the one
-    test: the unstable mode's growth rate against d), RS's derived amplitude law and
-    micro's fitted ones with their ranges and intervals, and where micro's is not settled."""
+    """The transition's verdict, one paragraph of at most :data:`VERDICT_WORDS` words, every
+    number computed in this run: how each model loses stability (the one test, the unstable
+    mode's growth rate against d), RS's derived amplitude law and how its simulation meets
+    it, micro's cycles against its derived total-shock law (the memory factor) and the
+    single power law fitted to them; the derivation is named by its page."""
     tr, rs_tr = v.get("transition", {}), v.get("rs_transition") or {}
     law = v.get("rs_amplitude_law", {})
     fit = t.get("hopf_fit", pd.DataFrame())
     pts = t.get("hopf_points", pd.DataFrame())
     out = []
+
+    def growth(x: dict) -> str:
+        return (f"{fmt(x['growth_far'], 3)} at d = {x['d_far']:.2g} to {fmt(x['growth_near'], 3)} at "
+                f"d = {x['d_near']:.2g}")
+
     micro_div, rs_div = tr.get("growth_diverges"), rs_tr.get("growth_diverges")
     if micro_div and rs_div:
-        out.append("At a = 0 both models lose stability at V^c in the same singular way, and neither by a Hopf "
-                   "bifurcation: the growth rate of the unstable mode of steady sliding diverges as V → V^c instead "
-                   f"of vanishing, micro's from {fmt(tr['growth_far'], 3)} at d = {tr['d_far']:.2g} to "
-                   f"{fmt(tr['growth_near'], 3)} at d = {tr['d_near']:.2g} (a real eigenvalue entering from "
-                   "infinity where the branching ratio reaches 1), RS's from "
-                   f"{fmt(rs_tr['growth_far'], 3)} at d = {rs_tr['d_far']:.2g} to {fmt(rs_tr['growth_near'], 3)} "
-                   f"at d = {rs_tr['d_near']:.2g} (the limit a → 0 of the Hopf pair of a > 0, whose frequency grows "
-                   "like a^(-1/2); its partner is the instantaneous slip). They differ in the nonlinear mechanism "
-                   "that sets the amplitude.")
+        out.append("At a = 0 both models lose stability at V^c the same singular way, not by a Hopf bifurcation: "
+                   f"the unstable mode's growth rate diverges at V^c (micro: {growth(tr)}; RS: {growth(rs_tr)}).")
     else:
-        said = []
-        for who, x in (("micro", tr), ("RS (a = 0)", rs_tr)):
-            if "growth_diverges" in x:
-                how = "diverges" if x["growth_diverges"] else "vanishes"
-                said.append(f"the growth rate of {who}'s unstable mode {how}"
-                            f" as V → V^c ({fmt(x['growth_far'], 3)} at d = {x['d_far']:.2g}, "
-                            f"{fmt(x['growth_near'], 3)} at d = {x['d_near']:.2g})")
+        said = [f"{who}'s growth rate {'diverges' if x['growth_diverges'] else 'vanishes'} as V → V^c "
+                f"({growth(x)})" for who, x in (("micro", tr), ("RS", rs_tr)) if "growth_diverges" in x]
         if said:
             out.append("By one test, " + "; ".join(said) + ".")
-    rs_fit = fit[fit.model == "RS"] if len(fit) else fit
     if math.isfinite(law.get("c0", math.nan)):
         rs = pts[(pts.model == "RS") & pts.fitted.astype(bool)].sort_values("d") if len(pts) else pts
         check = ""
         if len(rs) and math.isfinite(rs.asymptote.iloc[0]):
             dev = abs(rs.amplitude.iloc[0] / rs.asymptote.iloc[0] - 1)
-            check = f"; the simulated amplitude differs from it by a relative {dev:.1g} at d = {rs.d.iloc[0]:.2g}"
-        out.append("In RS the cycle is a stick and an instantaneous slip, whose return map gives "
-                   f"sigma_max − sigma_min = c0 d^(1/2) (1 + c2 d) with c0 = {fmt(law['c0'], 4)} and "
-                   f"c2 = {fmt(law['c2'], 3)} (derived, not fitted{check})"
-                   + (f"; a power law fitted to it gives {_beta(rs_fit.iloc[0])}" if len(rs_fit) else "") + ".")
-    elif len(rs_fit):
-        out.append(f"RS's amplitude, fitted: {_beta(rs_fit.iloc[0])}.")
-    mf = fit[fit.model == "micro"] if len(fit) else fit
-    said = []
-    for _, r in mf.iterrows():
-        how = ("the cohort method" if r.method == "cohort" else f"the N-block at N = {r.resolution:.0f}"
-               if r.method == "N-block" else f"the {r.method} at {_resolution(r, s)}")
-        said.append(f"{_beta(r)} by {how} ({int(r.n_points)} points)")
-    out.append("In micro the amplitude is set by the size of its shocks: each starts where the branching ratio "
-               "reaches 1, at a fold of the creep, and runs to a far root, a drop of about 2 kappa zbar times the "
-               "excess branching ratio of the margins beyond the layer the creep has emptied.")
-    out.append("It has no single power law (one is rejected at k0 = 0.1 and 0.01): while shocks are total it "
-               "depends on k0 V alone and is about linear in d (derived up to a measured memory factor of "
-               "0.72-0.92); below a crossover at d of about k0/k2 shocks stop being total, and once a shock moves "
-               "only a thin layer of margins a scaling argument makes the amplitude linear in d again, with a "
-               "prefactor not derived.")
-    out.append("There the unstable mode's time scale is itself proportional to d (derived), and the amplitude, "
-               "the loading time and the pre-shock distance from steady sliding all scale with d: constant to 5 % "
-               "at k0 = 0.3, d = 0.005-0.02 (A ≈ 0.25 d), and at k0 = 0.1 the local exponent rises from 0.59 at "
-               "the crossover to 0.95 at d = 0.001-0.002 (A ≈ 0.63 d) (docs/reference/micro_transition.md, "
-               "docs/validation/micro_transition.md).")
-    out.append("Fitted: " + "; ".join(said) + "." if said else "No amplitude law could be fitted.")
-    if micro_div and rs_div:
-        out.append("An exponent near 1/2 is therefore no evidence of a Hopf bifurcation.")
-    nb = mf[mf.method == "N-block"] if len(mf) else mf
-    each_N = ", ".join(f"{r.beta:.2f} at N = {r.resolution:.0f}" for _, r in nb.iterrows())
-    moves = f"; the N-block's exponent moves with N ({each_N})" if len(nb) > 1 else ""
-    out.append(f"The cohort method's error bars are bounds (the change from twice its time step and cell, plus "
-               "both fixed points' errors), checked against the Richardson limit of two finer levels at k0 = 0.3, "
-               f"0.1, 0.01 and 1e-3 down to d = {NEAR_VC:g}, where they cover the true error several times over "
-               "(docs/validation/micro_transition.md); closer to V^c they are not known, and at k0 = 0.01, d = 0.01 "
-               f"the report's step no longer certifies the fixed point{moves}.")
+            check = f" (simulation within {dev:.1g} at d = {rs.d.iloc[0]:.2g})"
+        out.append("RS's amplitude follows its derived law c0 d^(1/2) (1 + c2 d), "
+                   f"c0 = {fmt(law['c0'], 4)}, c2 = {fmt(law['c2'], 3)}{check}.")
+    lo, hi, n = memory_ratio(pts, s.hopf_k0, s.k2)
+    total = (f": above d = k0/k2 = {s.hopf_k0 / s.k2:.2g} (total shocks) the {n} cycles lie at {fmt(lo, 2)}-"
+             f"{fmt(hi, 2)} times the reset model's derived law (memory and O(k0) effects); below, it crosses over"
+             if n else ": it crosses over at d of about k0/k2")
+    out.append("Micro's amplitude follows no single power law" + total
+               + " (docs/reference/micro_transition.md).")
+    mf = fit[(fit.model == "micro") & (fit.method == "cohort")] if len(fit) else fit
+    if len(mf):
+        r = mf.iloc[0]
+        out.append(f"A power law fitted to the cohort's {int(r.n_points)} points gives {_beta(r)}"
+                   + (": an exponent near 1/2 is no evidence of a Hopf bifurcation." if micro_div and rs_div
+                      else "."))
     return " ".join(out)
 
 
 def summary(ctx: Context, part: Part) -> list[str]:
     s, t, v = ctx.s, part.tables, part.values
     fit, pts = t["hopf_fit"], t["hopf_points"]
+    level = f"{100 * float(fit.ci_level.iloc[0]):.0f} %" if len(fit) else "the"
     lines = [f"## The transition at k0 = {s.hopf_k0:g}", "",
              f"**Verdict: both models by one test.** {v['transition_verdict']}", "",
              ("Amplitude sigma_max − sigma_min ∝ d^beta, d = (V^c − V)/V^c with each model's own exact V^c "
               "(table `hopf_fit`; figure `hopf.png`):"), "",
-             "| model | method | resolution | beta | 95 % CI | s.e. | d range | points | asymptote |",
+             f"| model | method | resolution | beta | {level} CI | s.e. | d range | points | asymptote |",
              "|---|---|---|---|---|---|---|---|---|"]
     for _, r in fit.iterrows():
         lines.append(f"| {r.model} | {r.method} | {_resolution(r, s)} | {fmt(r.beta, 3)} | "
@@ -314,15 +401,45 @@ def summary(ctx: Context, part: Part) -> list[str]:
     lines += ["", "A fit rests only on points whose error is known: the cohort method's bars are bounds (twice the "
               "sum of its discretisation error, the change from twice the time step and cell, and its fixed-point "
               "error), the N-block's standard errors (the N-block sizes differ by their finite-N error), RS is "
-              f"exact to CVODE's tolerance. Closer to V^c than d = {NEAR_VC:g} the cohort's discretisation error "
-              "is not known (the bound is checked only down to there): such points are drawn open "
-              "and not fitted" + (f" ({len(near)} here)" if len(near) else " (none here)") + ". The 95 % interval "
-              "combines Student's t on the scatter about the line (n − 2 degrees of freedom, so it is wide with few "
-              "points) with what the points' error bars can move the slope (column `ci_basis`)."
+              f"exact to CVODE's tolerance. Closer to V^c than d = {NEAR_VC:g} (micro.api.NEAR_VC) the cohort's "
+              "discretisation error is not known: such points are drawn open and not fitted"
+              + (f" ({len(near)} here)" if len(near) else " (none here)") + ". How far down in d the bound is "
+              "checked at each k0 is stated, with its command, in docs/validation/micro_transition.md (section 1; "
+              "`python benchmarks/micro_transition_error_check.py`). The interval combines Student's t on the "
+              "scatter about the line (n − 2 degrees of freedom, so it is wide with few points) with what the "
+              "points' error bars can move the slope (column `ci_basis`)."
               + (f" {len(fp)} Fokker-Planck points (eps = {', '.join(f'{e:g}' for e in sorted(set(fp.resolution)))})"
                  " are shown open but not fitted: they are not converged in eps (no study in eps here)."
                  if len(fp) else ""), ""]
+    lines += _laws_summary(s, t)
     tr = v.get("transition", {})
     if tr.get("text"):
         lines += [tr["text"], ""]
     return lines
+
+
+def _laws_summary(s: Settings, t: dict[str, pd.DataFrame]) -> list[str]:
+    """What ``hopf.png`` draws for micro besides its points, with where each law comes from."""
+    laws = t.get("hopf_micro_laws")
+    if laws is None or not len(laws):
+        return []
+    said = []
+    r = laws[laws.law == "reset (R), derived"]
+    if len(r):
+        said.append(f"the reset model's total-shock law (R), A_r = k2 zbar q tau_r(q) ≈ 2 k2 zbar d_r (1 − d_r/3) "
+                    "with d_r = 1 − k0 V/(k2 gamma zbar), derived (docs/reference/micro_transition.md, "
+                    f"section 3.1), "
+                    f"from d = k0/k2 = {fmt(r.d.min(), 3)}, where shocks become total, to d = {fmt(r.d.max(), 2)}")
+    m = laws[laws.law == "reset (R) x measured memory factor"]
+    if len(m):
+        said.append(f"the same times the memory factor c_m measured at small k0 (d_r = {fmt(m.d_r.min(), 2)} to "
+                    f"{fmt(m.d_r.max(), 2)} here), not derived")
+    lin = laws[laws.law == "linear, measured"]
+    if len(lin):
+        c = float((lin.amplitude / lin.d).mean())
+        said.append(f"the linear law deep in the partial-shock regime, A = {fmt(c, 2)} d, "
+                    f"measured at d = {fmt(lin.d.min(), 2)} to {fmt(lin.d.max(), 2)} (prefactor not derived)")
+    return ["`hopf.png` also draws micro's laws (table `hopf_micro_laws`): " + "; ".join(said) + ". The measured "
+            f"constants come from `compare/data/{MEASURED_FILE}`, whose header names the study, its command "
+            "(`python benchmarks/micro_transition_fits.py`) and its date; the page is docs/validation/"
+            "micro_transition.md (sections 3 and 4).", ""]

@@ -9,7 +9,9 @@ bifurcation.  Right, both models' cycle amplitude against d on log-log axes, eac
 own exact V^c: micro's default (the cohort method, with a bar bounding its error where that
 is known), the N-block at two sizes (standard errors) and RS, each with its fitted power
 law and 95 % interval over the d it rests on; RS's asymptote c0 d^(1/2) (1 + c2 d) derived
-from its stick-slip map (micro has none derived yet).  ``rep["hopf_fit"]`` is the table,
+from its stick-slip map; micro's reset-model total-shock law, derived where shocks are total
+(d >~ k0/k2), and its measured linear law, labelled so (``rep["hopf_micro_laws"]``).
+``rep["hopf_fit"]`` is the table,
 ``rep.values["transition_verdict"]`` the verdict.
 
 This runs :func:`compare.report` for the ``hopf`` scenario with

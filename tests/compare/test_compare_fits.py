@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 
+import math
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -249,3 +251,53 @@ def test_fit_dc_uses_each_k0_s_own_law():
     assert fit.Dc == pytest.approx(Dc_true, rel=1e-3) and fit.rms < 1e-4 and fit.regime_agreement == 1.0
     one_law = fits.fit_dc(pts, lambda k0: laws[0.1], bounds=(0.01, 0.3), n_grid=15, n_bootstrap=20)
     assert one_law.rms > 5e-3 and abs(one_law.Dc / Dc_true - 1) > 1e-2
+
+
+def test_fit_dc_keeps_regime_agreement_apart_from_the_misfit():
+    """Issue 55: a stick-slip point that RS can only reproduce at small D_c no longer sets
+    D_c (a).  RS's own cycles with D_c = 0.07 at two k0, plus one made-up micro stick-slip
+    point at a V where RS slides steadily for D_c above its switch W(V)/k0 (below 0.07): the
+    fit returns 0.07 (the old objective, which charged a regime mismatch the RS amplitude,
+    stopped on that point's switch), counts the point as the one regime disagreement, keeps
+    it out of the misfit, and its profile steps down where the point leaves."""
+    A, B, Dc_true = 0.0076, 0.084, 0.07
+    laws = {0.1: rsf.HyperbolicLaw(A=A, B=B, mu_inf=0.89), 0.01: rsf.HyperbolicLaw(A=A, B=B, mu_inf=0.9)}
+    rows = []
+    for k0, law in laws.items():
+        vc = rsf.critical_velocity(law, k0, Dc_true).Vc
+        for r in (0.2, 0.4, 0.6, 0.8, 1.5):
+            cyc = rsf.limit_cycle(rsf.SpringSlider(law=law, k0=k0, Dc=Dc_true), r * vc)
+            rows.append({"k0": k0, "V": r * vc, "regime": cyc.regime, "sigma_max": cyc.sigma_max,
+                         "sigma_min": cyc.sigma_min, "converged": True})
+    # at k0 = 0.1, V = 0.0045 RS slides steadily for D_c > W(V)/k0 = 0.044: micro "sticks" there
+    stray = {"k0": 0.1, "V": 0.0045, "regime": "stick-slip", "sigma_max": 0.95, "sigma_min": 0.9, "converged": True}
+    pts = pd.DataFrame(rows + [stray])
+    switch = float(laws[0.1].weakening(np.array([0.0045]))[0]) / 0.1
+    assert 0.04 < switch < 0.05
+    fit = fits.fit_dc(pts, laws.__getitem__, bounds=(0.01, 0.3), n_grid=21, n_bootstrap=20)
+    assert fit.Dc == pytest.approx(Dc_true, rel=1e-3) and fit.rms < 1e-4
+    assert abs(math.log(fit.Dc / switch)) > 0.1 and fit.one_sided == ""
+    assert fit.n_disagree == 1 and fit.n_stick_slip == int((pts.regime == "stick-slip").sum()) - 1
+    bad = fit.points[~fit.points.regime_agrees]
+    assert list(bad.V) == [0.0045] and not bad.in_misfit.iloc[0]
+    assert fit.points.Dc_switch.iloc[-1] == pytest.approx(switch, rel=1e-12)
+    prof = fit.profile
+    below, above = prof[prof.Dc < switch].iloc[-1], prof[prof.Dc > switch].iloc[0]
+    assert below.n_stick_slip == above.n_stick_slip + 1 and above.n_disagree == below.n_disagree + 1
+    assert fit.Dc_profile[0] < fit.Dc < fit.Dc_profile[1]
+
+
+def test_dc_small_k0_is_the_fit_at_small_k0():
+    """At k0 = 1e-4 the closed form (RS's sigma_max = mu_inf + (A - k0 V D_c)/B, sigma_min =
+    mu_inf) and the full fit agree on extrema that are not RS's own (micro-like: sigma_max
+    off the line), to the fit's grid-refinement tolerance."""
+    law = rsf.HyperbolicLaw(A=0.0075, B=0.083, mu_inf=0.9)
+    k0 = 1e-4
+    V = np.array([150.0, 250.0, 400.0, 550.0, 700.0])
+    smax = law.mu_inf + (law.A - k0 * V * 0.08) / law.B + 0.004 * np.sin(V)
+    pts = pd.DataFrame({"k0": k0, "V": V, "regime": "stick-slip", "sigma_max": smax, "sigma_min": law.mu_inf,
+                        "converged": True})
+    closed = fits.dc_small_k0(pts, law)
+    fit = fits.fit_dc(pts, lambda k: law, bounds=(0.01, 0.3), n_grid=21, n_bootstrap=0)
+    assert abs(closed / 0.08 - 1) > 1e-3            # the noise moves it off the generating value
+    assert fit.Dc == pytest.approx(closed, rel=1e-4)

@@ -3,6 +3,8 @@ closed forms, analytic limits, the N-block's bracket of V^c (docs/reference/micr
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -28,6 +30,17 @@ def test_critical_velocity_table_has_all_five_k0_and_the_kept_columns(rep):
     assert small.Vc_micro[1e-4] == pytest.approx(small.Vc_micro_small_k0[1e-4], rel=1e-3)
     # ... and against the N-block's bracket at k0 = 0.1 (stick-slip at 0.70, steady at 0.75)
     assert 0.70 < small.Vc_micro[0.1] < 0.75
+
+
+def test_summary_states_vc_error_and_branch_tolerance_as_computed(rep):
+    """The critical-velocity paragraph quotes the largest relative error of micro's V^c in this
+    run's table (it used to state a fixed 'error below 1e-9'), and the Eq. (10) paragraph the
+    steady tasks' own tolerance."""
+    crit = rep["critical_velocity"]
+    worst = float((crit.Vc_micro_err / crit.Vc_micro).max())
+    assert f"relative error at most {compare.summary.fmt(worst, 2)}" in rep.summary
+    assert "error below 1e-9" not in rep.summary
+    assert f"micro's direct method, to {compare.tasks.SteadyTask.tol:g};" in rep.summary
 
 
 def test_rs_critical_velocity_is_the_closed_form_root(rep):
@@ -131,27 +144,87 @@ def test_transition_table_one_row_per_method_with_interval_and_range(rep):
         assert (r.d_min, r.d_max) == (used.d.min(), used.d.max())
         assert r.beta_low < r.beta == r.exponent < r.beta_high
         if r.model == "micro":
-            assert np.isfinite(used.amplitude_stderr).all() and r.asymptote == "none derived"
+            assert np.isfinite(used.amplitude_stderr).all() and r.asymptote.startswith("reset model (R) derived")
     # RS's amplitude against the derived asymptote c0 d^(1/2) (1 + c2 d), nothing fitted: the
     # report's closest point (d = 0.01) within 1e-4 (measured 8e-6; the next order is ~d^2)
     rs = fit.set_index("model").loc["RS"]
     assert rs.asymptote_ratio_at_d_min == pytest.approx(1.0, abs=1e-4)
 
 
-def test_transition_verdict_is_one_paragraph_on_both_sides(rep):
-    """The verdict a physicist can quote: both lose stability the same singular way, RS's
-    d^(1/2) with the prefactor from the map, micro's fitted exponent with range and interval,
-    and how far micro's error bars are checked."""
+def test_transition_verdict_is_one_quotable_paragraph(rep):
+    """The verdict a physicist can quote: one paragraph of at most 150 words (it had 566),
+    in the summary, with RS's derived law and micro's fitted exponent as this run computed
+    them, and none of the numbers it used to copy from the validation record."""
+    from compare.scenarios import transition
+
     text = rep.values["transition_verdict"]
     assert "\n" not in text and text in rep.summary
+    assert len(text.split()) <= transition.VERDICT_WORDS == 150
     law = rep.values["rs_amplitude_law"]
     cohort = rep["hopf_fit"].set_index("method").loc["cohort"]
     for part in ("same singular way", "c0 d^(1/2) (1 + c2 d)", f"c0 = {law['c0']:.4g}",
                  f"beta = {cohort.beta:.2f} (95 % CI {cohort.beta_low:.2f} to {cohort.beta_high:.2f})",
-                 "It has no single power law", "crossover at d of about k0/k2",
-                 "time scale is itself proportional to d", "checked against the Richardson limit",
-                 "down to d = 0.02"):
+                 "docs/reference/micro_transition.md"):
         assert part in text, part
+    for copied in ("0.72-0.92", "constant to 5 %", "from 0.59", "A ≈ 0.63 d", "A ≈ 0.25 d",
+                   "rejected at k0 = 0.1 and 0.01", "down to d = 0.02"):
+        assert copied not in text, copied
+
+
+def test_transition_verdict_follows_the_data(rep):
+    """Change the run's data and the verdict's numbers change with it: micro's cohort
+    amplitudes 1.25 times larger move the stated memory factor (cycles over the reset
+    model's derived law) by that factor, and another RS prefactor and growth rate appear."""
+    import copy
+    from compare.scenarios import transition
+
+    s = rep.settings
+    tables = {k: rep.tables[k].copy() for k in ("hopf_points", "hopf_fit")}
+    values = copy.deepcopy({k: rep.values[k] for k in ("transition", "rs_transition", "rs_amplitude_law")})
+    pts = tables["hopf_points"]
+    lo, hi, n = transition.memory_ratio(pts, s.hopf_k0, s.k2)
+    assert n >= 1 and f"{lo:.2g}-{hi:.2g} times the reset model's derived law" in rep.values["transition_verdict"]
+    cohort = (pts.model == "micro") & (pts.method == "cohort")
+    pts.loc[cohort, "amplitude"] *= 1.25
+    values["rs_amplitude_law"]["c0"] = 0.1234567
+    values["transition"]["growth_near"] = 98765.0
+    text = transition.verdict(s, tables, values)
+    lo2, hi2, n2 = transition.memory_ratio(pts, s.hopf_k0, s.k2)
+    assert (lo2, hi2, n2) == pytest.approx((1.25 * lo, 1.25 * hi, n))
+    assert f"{lo2:.2g}-{hi2:.2g} times the reset model's derived law" in text
+    assert f"{lo:.2g}-{hi:.2g} times" not in text
+    assert "c0 = 0.1235" in text and "9.88e+04" in text
+    assert len(text.split()) <= transition.VERDICT_WORDS
+
+
+def test_hopf_draws_micros_derived_and_measured_laws(rep):
+    """hopf_micro_laws: the reset model's total-shock law (R) from d = k0/k2 (against the
+    closed form's expansion 2 k2 zbar d_r (1 - d_r/3), its next order ~d_r^3), the same times
+    the measured memory factor (below it), and the measured linear law at k0 = 0.1 from the
+    package's data file, whose header states its command and date."""
+    from compare.scenarios import transition
+
+    s = rep.settings
+    laws = rep["hopf_micro_laws"]
+    r = laws[laws.law == "reset (R), derived"]
+    assert r.d.min() == pytest.approx(s.hopf_k0 / s.k2, rel=1e-12)
+    q = 1.0 - r.d_r.to_numpy()
+    tau = r.amplitude.to_numpy() / (s.k2 * s.zbar * q)           # A_r = k2 zbar q tau_r(q)
+    np.testing.assert_allclose(-np.expm1(-tau) / tau, q, rtol=1e-10)
+    vcr = s.k2 * (s.k2 / 1.0) * s.zbar / s.hopf_k0               # V^c_r = k2 gamma zbar / k0, gamma = k2 / eta_u
+    vc = float(rep["hopf_points"].query("model == 'micro'").Vc.iloc[0])
+    np.testing.assert_allclose(r.d_r, 1.0 - vc * (1.0 - r.d) / vcr, rtol=1e-6)
+    small = transition.reset_amplitude(micro.Model(k0=s.hopf_k0), vcr * (1 - np.array([1e-3, 1e-2])))
+    np.testing.assert_allclose(small, 2 * s.k2 * s.zbar * np.array([1e-3, 1e-2]) * (1 - np.array([1e-3, 1e-2]) / 3),
+                               rtol=2e-4)
+    m = laws[laws.law == "reset (R) x measured memory factor"].set_index("d")
+    assert len(m) and (m.amplitude < r.set_index("d").amplitude.reindex(m.index)).all()
+    lin = laws[laws.law == "linear, measured"]
+    assert len(lin) and np.allclose(lin.amplitude / lin.d, (lin.amplitude / lin.d).iloc[0])
+    path = Path(transition.__file__).parents[1] / "data" / transition.MEASURED_FILE
+    header = [ln for ln in path.read_text().splitlines() if ln.startswith("#")]
+    assert any("python benchmarks/" in ln for ln in header)
+    assert any(re.search(r"20\d\d-\d\d-\d\d", ln) for ln in header)
 
 
 def test_every_figure_and_the_summary_are_written(rep):
