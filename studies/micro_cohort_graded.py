@@ -1,4 +1,4 @@
-"""Graded steps against uniform steps in long loading phases (micro.cohort._step_length).
+"""Graded steps against uniform steps in long loading phases (the cohort method's graded step rule).
 
 Fig. 4 parameters, the five k0 of Fig. 10 at V = 0.1 V^c (``--fraction``, or ``--V`` for
 an absolute drive), where a loading phase lasts 7-11 relaxation times.  Each point is a
