@@ -405,7 +405,7 @@ def summary(ctx: Context, part: Part) -> list[str]:
               "discretisation error is not known: such points are drawn open and not fitted"
               + (f" ({len(near)} here)" if len(near) else " (none here)") + ". How far down in d the bound is "
               "checked at each k0 is stated, with its command, in docs/validation/micro_transition.md (section 1; "
-              "`python benchmarks/micro_transition_error_check.py`). The interval combines Student's t on the "
+              "`python -m studies micro_transition_error_check`). The interval combines Student's t on the "
               "scatter about the line (n − 2 degrees of freedom, so it is wide with few points) with what the "
               "points' error bars can move the slope (column `ci_basis`)."
               + (f" {len(fp)} Fokker-Planck points (eps = {', '.join(f'{e:g}' for e in sorted(set(fp.resolution)))})"
@@ -441,5 +441,5 @@ def _laws_summary(s: Settings, t: dict[str, pd.DataFrame]) -> list[str]:
                     f"measured at d = {fmt(lin.d.min(), 2)} to {fmt(lin.d.max(), 2)} (prefactor not derived)")
     return ["`hopf.png` also draws micro's laws (table `hopf_micro_laws`): " + "; ".join(said) + ". The measured "
             f"constants come from `compare/data/{MEASURED_FILE}`, whose header names the study, its command "
-            "(`python benchmarks/micro_transition_fits.py`) and its date; the page is docs/validation/"
+            "(`python -m studies micro_transition_fits`) and its date; the page is docs/validation/"
             "micro_transition.md (sections 3 and 4).", ""]

@@ -577,7 +577,7 @@ def test_the_slow_modes_are_the_single_blocks_relaxing():
 
 #: The N-block near V^c (micro.nblock, no code shared with the cohort method):
 #: benchmarks/results/micro_transition_nblock_check.csv, written by
-#: benchmarks/micro_transition_nblock_check.py (its docstring has the commands; 100 shocks
+#: studies/micro_transition_nblock_check.py (its docstring has the commands; 100 shocks
 #: discarded, 200-1500 cycles averaged, N = 1e4 to 1e6, several seeds).
 NBLOCK_NEAR_VC = Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "micro_transition_nblock_check.csv"
 
