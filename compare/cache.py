@@ -14,12 +14,13 @@ from __future__ import annotations
 import json
 import logging
 import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
 from rsf.results import write_atomically
 
-__all__ = ["PointCache", "NullCache", "default_cache_dir"]
+__all__ = ["PointCache", "NullCache", "default_cache_dir", "check_cache_dir"]
 
 log = logging.getLogger(__name__)
 
@@ -31,6 +32,40 @@ def default_cache_dir() -> Path:
         return Path(env).expanduser()
     base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     return Path(base) / "frictionkit-compare"
+
+
+def check_cache_dir(directory: str | os.PathLike, out: str | os.PathLike | None = None, *,
+                    option: str = "cache_dir", out_option: str = "out") -> Path:
+    """The cache folder ``directory`` can be written, and is neither the report folder
+    ``out`` nor inside it (the report would refuse the folder the cache filled): raise
+    ValueError, one line naming ``option``, before anything is computed.
+
+    Writable means that a folder can be created in it (the cache makes one per shard), or,
+    if it does not exist yet, in its nearest existing parent; this is tried (and undone).
+    """
+    text = os.fspath(directory)
+    if not text.strip():
+        raise ValueError(f"{option} must name a folder, got {text!r}")
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{option} {text!r} is a file, not a folder")
+    existing = path
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise ValueError(f"{option} {text!r} cannot be created: {str(existing)!r} is not a folder")
+    try:
+        os.rmdir(tempfile.mkdtemp(dir=existing, prefix=".compare-probe-"))
+    except OSError as exc:
+        raise ValueError(f"{option} {text!r} is not writable (cannot create a folder in {str(existing)!r}: "
+                         f"{exc.strerror})") from None
+    if out is not None:
+        cache, report = Path(os.path.realpath(text)), Path(os.path.realpath(os.fspath(out)))
+        if cache == report or report in cache.parents:
+            where = "the report folder" if cache == report else "inside the report folder"
+            raise ValueError(f"{option} {text!r} is {where} {out_option} {os.fspath(out)!r}; give a cache "
+                             "folder outside it")
+    return path
 
 
 class PointCache:

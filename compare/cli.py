@@ -14,6 +14,7 @@ import threading
 
 from tqdm.contrib.logging import logging_redirect_tqdm
 
+from .cache import check_cache_dir, default_cache_dir
 from .params import SCENARIOS, Settings
 from .report import report
 
@@ -87,6 +88,9 @@ def main(argv: list[str] | None = None) -> int:
         changes["scenarios"] = tuple(args.scenario)
     try:
         _check_args(args)
+        if not args.no_cache:  # (report() checks the same, naming its parameters)
+            check_cache_dir(default_cache_dir() if args.cache_dir is None else args.cache_dir, args.out,
+                            option="--cache-dir", out_option="--out")
         factory = Settings.quick if args.quick else Settings.paper if args.paper else Settings.default
         settings = factory(**changes)
         with logging_redirect_tqdm():  # log lines above the progress bars, not glued to them
@@ -97,8 +101,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("interrupted: the finished micro points are in the cache; the same command resumes from them",
-              file=sys.stderr)
+        if args.no_cache:
+            print("interrupted: with --no-cache nothing was kept; the same command computes every point again",
+                  file=sys.stderr)
+        else:
+            print("interrupted: the finished micro points are in the cache; the same command resumes from them",
+                  file=sys.stderr)
         return 130
     print(f"wrote {rep.out} ({len(rep.tables)} tables, {len(rep.figures)} figures) in {rep.wall_time:.1f} s; "
           f"read {rep.out / 'summary.md'}")

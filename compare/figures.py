@@ -69,6 +69,9 @@ class Painter:
         except Exception as exc:  # noqa: BLE001 - (a broken pool): drawn here by finish()
             future = Future()
             future.set_exception(exc)
+        except BaseException:  # Ctrl-C while it was drawn here (no pool): not left in the folder
+            Path(tmp).unlink(missing_ok=True)
+            raise
         self._jobs.append((name, Path(tmp), fn_name, data, future))
         return self.folder.path / name
 

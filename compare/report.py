@@ -44,7 +44,7 @@ import pandas as pd
 
 from . import figures
 from ._validation import positive
-from .cache import NullCache, PointCache
+from .cache import NullCache, PointCache, check_cache_dir, default_cache_dir
 from .context import SHARED_FIGURES, Context, micro_frame
 from .output import ReportFolder, check_folder
 from .params import Settings
@@ -164,7 +164,8 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
         If ``settings`` is not a :class:`~compare.params.Settings`, ``scenarios`` names an
         unknown scenario, ``Dc`` is not a finite number > 0, ``out`` cannot be written (a
         file, a non-empty folder no report wrote, no write permission: checked before any
-        computation), ``cache_dir`` is a file, ``workers`` is not an integer >= 1 or
+        computation), ``cache_dir`` is a file, cannot be written, or is ``out`` or inside it
+        (checked before any computation too), ``workers`` is not an integer >= 1 or
         ``scheduler`` is neither an address nor a client (or dask is missing).
 
     Examples
@@ -183,6 +184,8 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
         Dc = positive("Dc", Dc)
     if out is not None:
         check_folder(out)  # before any computation
+    if use_cache:
+        check_cache_dir(default_cache_dir() if cache_dir is None else cache_dir, out)
     cache = PointCache(cache_dir) if use_cache else NullCache()
     rep = Report(settings=settings)
     selected = [sc for sc in REGISTRY if sc.wanted(settings)]

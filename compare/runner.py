@@ -218,9 +218,12 @@ class Runner:
         once (their points are lost; finished ones are already in the cache)."""
         if self._pool is not None:
             if kill:
-                for proc in list((getattr(self._pool, "_processes", None) or {}).values()):
+                procs = list((getattr(self._pool, "_processes", None) or {}).values())
+                for proc in procs:
                     proc.terminate()
                 self._pool.shutdown(wait=False)
+                for proc in procs:  # gone before the caller removes what they were writing (a figure)
+                    proc.join(timeout=2.0)
             else:
                 self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None

@@ -186,6 +186,9 @@ def test_an_interrupt_terminates_running_tasks_instead_of_waiting_for_them():
         def terminate(self):
             calls.append("terminate")
 
+        def join(self, timeout=None):
+            calls.append("join")
+
     class Pool:
         _processes = {1: Worker(), 2: Worker()}
 
@@ -197,7 +200,8 @@ def test_an_interrupt_terminates_running_tasks_instead_of_waiting_for_them():
     with pytest.raises(KeyboardInterrupt):
         with runner:
             raise KeyboardInterrupt
-    assert calls == ["terminate", "terminate", ("shutdown", False)]
+    # (and waits for them to be gone, so that none writes a figure the report then removes: issue 54, D18)
+    assert calls == ["terminate", "terminate", ("shutdown", False), "join", "join"]
     calls.clear()
     runner._pool = Pool()
     with runner:
