@@ -118,7 +118,8 @@ def _replace_refusal(st: os.stat_result) -> str | None:
     euid, groups, mode = os.geteuid(), _groups(), stat.S_IMODE(st.st_mode)
     bit = stat.S_IWUSR if st.st_uid == euid else stat.S_IWGRP if st.st_gid in groups else stat.S_IWOTH
     if not mode & bit:
-        whose = "read-only" if st.st_uid == euid else f"a file of another user (uid {st.st_uid}) that this user may not write"
+        whose = ("read-only" if st.st_uid == euid else
+                 f"a file of another user (uid {st.st_uid}) that this user may not write")
         return f"is {whose} (mode {mode:04o}): it is not replaced; give another file"
     if euid != 0 and (st.st_uid != euid or st.st_gid not in groups):
         return (f"belongs to uid {st.st_uid}, gid {st.st_gid}: replacing it would change its owner; "

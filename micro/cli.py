@@ -213,8 +213,8 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("--no-growth-rate", dest="growth_rate", action="store_false",
                     help="skip the growth rate of the unstable mode (about 0.03 s per unstable V)")
     st.add_argument("--out", required=True,
-                    help="output CSV (- for standard output): k0,k1,k2,zbar,V,sigma,branching_ratio,stable,growth_rate,sigma_error,converged,"
-                         "method (chain, fixed point or no dashpot)")
+                    help="output CSV (- for standard output): k0,k1,k2,zbar,V,sigma,branching_ratio,stable,"
+                         "growth_rate,sigma_error,converged,method (chain, fixed point or no dashpot)")
 
     s = sub.add_parser("sweep", help="stationary state for each drive velocity: one CSV row per V")
     _model_options(s)
@@ -224,8 +224,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "(seconds per row at every k0; the Fokker-Planck equation only for non-exponential jumps); "
                         "cohort: the same, never the Fokker-Planck state; fp: time-step every row (minutes)")
     s.add_argument("--out", required=True,
-                   help="output CSV (- for standard output), a file rewritten after every row: k0,k1,k2,zbar,V,method,regime,sigma_max,sigma_min,"
-                        "sigma_mean,...,sigma_stderr,discretisation_error,...")
+                   help="output CSV (- for standard output), a file rewritten after every row: k0,k1,k2,zbar,V,"
+                        "method,regime,sigma_max,sigma_min,sigma_mean,...,sigma_stderr,discretisation_error,...")
 
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
                                         "(--method fp: bisection on Fokker-Planck runs, the paper's Appendix B)")
@@ -241,7 +241,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="decide oscillations smaller than 2 eps by their size and global shocks instead of "
                         "rerunning them at eps/2 (several times faster near Vc, but Vc then carries the "
                         "grid's error: k0=0.1, eps=0.016: 0.90 against 0.73)")
-    c.add_argument("--out", required=True, help="output CSV (- for standard output): k0,k1,k2,zbar,Vc,V_low,V_high,status,message,method")
+    c.add_argument("--out", required=True,
+                   help="output CSV (- for standard output): k0,k1,k2,zbar,Vc,V_low,V_high,status,message,method")
 
     r = sub.add_parser("run", help="stress time series of one protocol: columns t,w,sigma")
     _model_options(r)
@@ -251,7 +252,8 @@ def build_parser() -> argparse.ArgumentParser:
     drive.add_argument("--shs", nargs=4, type=float, metavar=("V", "SLIDE", "HOLD", "RESUME"),
                        help="slide-hold-slide: drive at V for SLIDE, hold for HOLD, resume for RESUME")
     r.add_argument("--duration", type=float, help="run length for --V, in (0, 1e8]")
-    r.add_argument("--out", required=True, help="output CSV (- for standard output): t,w,sigma (plus window min/max/mean)")
+    r.add_argument("--out", required=True,
+                   help="output CSV (- for standard output): t,w,sigma (plus window min/max/mean)")
     return p
 
 

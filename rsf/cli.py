@@ -360,7 +360,8 @@ def build_parser() -> argparse.ArgumentParser:
     pr.add_argument("--t-end", type=float, required=True,
                     help=f"end time, in (0, {T_END_MAX:g}] (the bound of rsf.simulate's t_end)")
     pr.add_argument("--out", required=True, help="output CSV for the time series (- for standard output)")
-    pr.add_argument("--events", default=None, help="output CSV for the events t, kind, sigma, theta, x (- for standard output)")
+    pr.add_argument("--events", default=None,
+                    help="output CSV for the events t, kind, sigma, theta, x (- for standard output)")
     pr.add_argument("--t-eval", type=_floats, default=None,
                     help="output times t1,t2,... (strictly increasing, in [0, t-end]): samples "
                          "exactly there instead of at every integrator step")
