@@ -6,8 +6,10 @@ scenario, a process pool over the machine's cores, the disk cache, ``./compare-r
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import math
+import re
 import signal
 import sys
 import threading
@@ -36,8 +38,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"k0 of the micro bifurcation diagram, each in (0, {K0_MAX:g}) (the RS side always "
                         "shows the paper's five)")
     p.add_argument("--eps", type=float, help="micro bin eps > 0 (smaller: more accurate, cost ~ eps^-2.6)")
-    p.add_argument("--dc", type=float, metavar="DC", help="use this D_c > 0 instead of fitting it")
-    p.add_argument("--workers", type=int, help="local worker processes >= 1 (default: the cores this process may use; 1: serial)")
+    p.add_argument("--dc", type=float, metavar="DC",
+                   help="use this D_c instead of fitting it, in the fit's range [0.005, 0.5]")
+    p.add_argument("--workers", type=int,
+                   help="local worker processes >= 1 (default: the cores this process may use; more are capped at "
+                        "them, with a warning; 1: serial)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="dask.distributed scheduler address, e.g. tcp://host:8786 (needs the 'dask' extra)")
     p.add_argument("--cache-dir", metavar="DIR",
@@ -45,7 +50,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.add_argument("-v", "--verbose", action="count", default=0, help="more logging (-v info, -vv debug)")
-    p.epilog = (f"Limits: --k0 in (0, {K0_MAX:g}), --eps and --dc > 0, --workers >= 1.  Exit status: 0 "
+    p.epilog = (f"Limits: --k0 in (0, {K0_MAX:g}), --eps > 0, --dc in [0.005, 0.5], --workers >= 1 (at most "
+                "the cores).  Exit status: 0 "
                 "success, 2 bad input (one line on stderr), 130 interrupted.")
     return p
 
@@ -67,6 +73,25 @@ def _check_args(args: argparse.Namespace) -> None:
             raise ValueError(f"{option} must be a finite number > 0, got {value:g}")
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers must be an integer >= 1, got {args.workers}")
+
+
+#: The parameters of compare.Settings and compare.report that options set, and the options.
+_OPTIONS = {"eps": "--eps", "Dc": "--dc", "cache_dir": "--cache-dir", "workers": "--workers", "k0": "--k0",
+            "scenarios": "--scenario"}
+
+
+@contextlib.contextmanager
+def _named():
+    """A ValueError whose message starts with a parameter an option sets names the option
+    (``eps must be ...`` -> ``--eps must be ...``)."""
+    try:
+        yield
+    except ValueError as exc:
+        text = str(exc)
+        match = re.match(r"[A-Za-z_][A-Za-z0-9_]*", text)
+        if match and match.group(0) in _OPTIONS:
+            raise ValueError(_OPTIONS[match.group(0)] + text[match.end():]) from None
+        raise
 
 
 def _terminate(signum, frame) -> None:
@@ -92,11 +117,13 @@ def main(argv: list[str] | None = None) -> int:
             check_cache_dir(default_cache_dir() if args.cache_dir is None else args.cache_dir, args.out,
                             option="--cache-dir", out_option="--out")
         factory = Settings.quick if args.quick else Settings.paper if args.paper else Settings.default
-        settings = factory(**changes)
+        with _named():
+            settings = factory(**changes)
         with logging_redirect_tqdm():  # log lines above the progress bars, not glued to them
-            rep = report(settings, out=args.out, Dc=args.dc, cache_dir=args.cache_dir,
-                         use_cache=not args.no_cache, workers=args.workers, scheduler=args.scheduler,
-                         progress=not args.no_progress)
+            with _named():
+                rep = report(settings, out=args.out, Dc=args.dc, cache_dir=args.cache_dir,
+                             use_cache=not args.no_cache, workers=args.workers, scheduler=args.scheduler,
+                             progress=not args.no_progress)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

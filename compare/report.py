@@ -165,7 +165,7 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
         (The paper's Figs. 3 and 10 come with ``bifurcation`` when ``settings.paper_figures``.)
     Dc : float, optional
         Use this D_c instead of fitting it to the stick-slip extrema (D_c from V^c
-        matching is still reported).
+        matching is still reported); within ``settings.dc_bounds``, the fit's range.
     cache_dir, use_cache : where micro records are cached (default: ``$COMPARE_CACHE_DIR`` or
         ``~/.cache/frictionkit-compare``), or no cache at all.
     workers : int, optional
@@ -185,7 +185,7 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
     ------
     ValueError
         If ``settings`` is not a :class:`~compare.params.Settings`, ``scenarios`` names an
-        unknown scenario, ``Dc`` is not a finite number > 0, ``out`` cannot be written (a
+        unknown scenario, ``Dc`` is not a finite number in ``settings.dc_bounds``, ``out`` cannot be written (a
         file, a non-empty folder no report wrote, no write permission: checked before any
         computation), ``cache_dir`` is a file, cannot be written, or is ``out`` or inside it
         (checked before any computation too), ``workers`` is not an integer >= 1 or
@@ -204,7 +204,10 @@ def report(settings: Settings | None = None, *, out: str | Path | None = None,
     if scenarios is not None:
         settings = settings.with_(scenarios=tuple(scenarios))
     if Dc is not None:
-        Dc = positive("Dc", Dc)
+        lo, hi = settings.dc_bounds
+        if not lo <= positive("Dc", Dc) <= hi:   # outside, the RS side may have no stick-slip at all
+            raise ValueError(f"Dc must be in [{lo:g}, {hi:g}] (the range the D_c fit searches, "
+                             f"Settings.dc_bounds), got {float(Dc):g}")
     if out is not None:
         check_folder(out)  # before any computation
     if use_cache:

@@ -31,11 +31,11 @@ import pandas as pd
 from . import fp
 from .analytic import sigma_fast_limit
 from .cohort import GRADED_MAX, cycle_cohorts, not_applicable as cohort_not_applicable
-from .methods import FP, Auto, Cohort, Convergence, Method, Renewal, check_velocity, resolve
-from .params import Model
+from .methods import COHORT_STEPS_MAX, FP, Auto, Cohort, Convergence, Method, Renewal, check_velocity, resolve
+from .params import Model, _number
 from .protocols import Drive
-from .renewal import critical_velocity_renewal, steady_sliding
-from .results import Critical, CycleFixedPoint, Run, Stationary
+from .renewal import V_RANGE, critical_velocity_renewal, steady_sliding
+from .results import BELOW, Critical, CycleFixedPoint, Run, Stationary
 
 __all__ = ["stationary", "sweep", "critical_velocity", "simulate", "slide_hold_slide"]
 
@@ -104,6 +104,21 @@ def cohort_steps_per_cycle(model: Model, V: float, dt: float) -> float:
     stress rises by the velocity weakening ``f_th - sigma_fast_limit`` at the rate
     ``k0 V``, in steps of up to ``GRADED_MAX dt`` (4 dt) away from the shocks."""
     return (model.f_th - sigma_fast_limit(model)) / (model.k0 * V) / (GRADED_MAX * dt)
+
+
+def check_cohort_work(model: Model, V: float, opts: Cohort) -> None:
+    """Refuse (one ValueError naming ``Cohort dt``) a stick-slip row whose loading phase
+    would take more than ``COHORT_STEPS_MAX`` steps (:func:`cohort_steps_per_cycle`), before
+    anything is computed.  Rows above V^c are steady (the renewal chain): not checked."""
+    if not V < _vc(model) or cohort_not_applicable(model):
+        return
+    steps = cohort_steps_per_cycle(model, V, opts.dt)
+    if steps > COHORT_STEPS_MAX:
+        dt_min = opts.dt * steps / COHORT_STEPS_MAX
+        raise ValueError(f"Cohort dt must be >= {dt_min:.3g} at V = {V:g} (k0 = {model.k0:g}): with dt = {opts.dt:g} "
+                         f"a cycle's loading would take about {steps:.2g} steps, more than {COHORT_STEPS_MAX:.0e} "
+                         f"(hours per cycle, and 10-20 cycles are needed)"
+                         + ("" if dt_min <= 0.1 else "; no dt up to 0.1 will do: a larger V or k0 will"))
 
 
 def _cohort_row(model: Model, V: float, opts: Cohort, warn: bool,
@@ -251,6 +266,7 @@ def stationary(
             raise ValueError("initial: a cohort cycle cannot start a Fokker-Planck run; give a Grid or 'auto'")
         return _fp_row(model, V, numerics, convergence, warn, initial, keep_records, keep_grid)
     opts.cohort.cell(model)  # (a cell out of range fails now)
+    check_cohort_work(model, V, opts.cohort)
     return _direct_then_cycle(model, V, opts, numerics, convergence, warn, cycle_start)
 
 
@@ -291,7 +307,10 @@ def sweep(
     if numerics is not None:
         numerics.settings(model)
     if isinstance(opts, (Auto, Cohort)):
-        (opts.cohort if isinstance(opts, Auto) else opts).cell(model)
+        cohort = opts.cohort if isinstance(opts, Auto) else opts
+        cohort.cell(model)
+        for V in velocities:     # every row's work before the first is computed
+            check_cohort_work(model, V, cohort)
     rows: list[dict] = []
     seed_grid = None
     for V in velocities:
@@ -309,6 +328,15 @@ def sweep(
 
 
 # ------------------------------------------------------------------------------ critical velocity
+def _in_velocity_range(V: float, name: str) -> float:
+    """``V`` within the velocities the steady branch takes (``micro.renewal.V_RANGE``), or one
+    ValueError naming it."""
+    low, high = V_RANGE
+    if not low <= V <= high:
+        raise ValueError(f"{name} must be in [{low:g}, {high:g}] (the velocities of the steady branch), got {V:g}")
+    return V
+
+
 def critical_velocity(
     model: Model,
     *,
@@ -342,14 +370,16 @@ def critical_velocity(
     -------
     Critical
         ``Vc = nan`` with status ``"no stick-slip"`` where steady sliding is stable at every
-        V (``k0 >= k2``); ``inf`` with ``"above range"`` beyond ``V_max``.
+        V (``k0 >= k2``) and with ``"V^c below V_min"`` where it lies below the range;
+        ``inf`` with ``"V^c above V_max"`` beyond ``V_max``.
     """
     _check_model(model)
     opts = resolve(method, ("auto", "renewal", "fp"), "critical_velocity")
     numerics = _check_numerics(numerics, method)
     bisect = isinstance(opts, FP)
-    V_min = check_velocity(V_min, "V_min")
-    V_max = check_velocity((1e3 if bisect else 1e7) if V_max is None else V_max, "V_max")
+    V_min = _in_velocity_range(check_velocity(V_min, "V_min"), "V_min")
+    V_max = _in_velocity_range(check_velocity((1e3 if bisect else 1e7) if V_max is None else V_max, "V_max"),
+                               "V_max")
     if not V_max > V_min:
         raise ValueError(f"V_max must be > V_min, got V_min={V_min:g}, V_max={V_max:g}")
     V_guess = check_velocity(V_guess, "V_guess")
@@ -365,10 +395,10 @@ def critical_velocity(
     renewal = opts.renewal if isinstance(opts, Auto) else opts
     Vc, error, status, message, evaluations = critical_velocity_renewal(model, V_min=V_min, V_max=V_max,
                                                                          tol=renewal.tol)
-    if status == "no stick-slip":
-        Vc = math.nan  # (no critical velocity: rsf's encoding of 'stable at every V' too)
+    if status in ("no stick-slip", BELOW):
+        Vc = math.nan  # (no critical velocity in the range: rsf's encoding of 'stable at every V' too)
     low, high = (Vc - error, Vc + error) if math.isfinite(Vc) and Vc > 0.0 else (
-        (0.0, V_min) if status == "no stick-slip" else (V_max, math.inf))
+        (0.0, V_min) if status in ("no stick-slip", BELOW) else (V_max, math.inf))
     if status != "converged":
         log.info("micro.critical_velocity(k0=%g, k1=%g, k2=%g): %s", model.k0, model.k1, model.k2, message)
     return Critical(model, Vc, low, high, status, message, evaluations, method="renewal")
@@ -420,8 +450,59 @@ def simulate(
     """
     _check_model(model)
     numerics = _transient_method(method, numerics, "simulate")
+    drive, duration = _check_drive(drive, duration)
+    for name, value in (("record_dsigma", record_dsigma), ("record_dt", record_dt)):
+        if value is not None and not (math.isfinite(_number(name, value)) and float(value) > 0.0):
+            raise ValueError(f"{name} must be a finite number > 0 (or None for the default), got {_shown(value)}")
     return fp.simulate_fp(model, drive, duration=duration, numerics=numerics, initial=initial,
                           record_dsigma=record_dsigma, record_dt=record_dt, progress=progress)
+
+
+#: The longest simulated time a protocol may ask for (as the command line's).
+T_MAX = 1e8
+
+
+def _shown(value) -> str:
+    """``repr(value)`` with numpy scalars as plain Python values (``'x'``, not ``np.str_('x')``)."""
+    return repr(value.item() if isinstance(value, np.generic) else value)
+
+
+def _check_drive(drive, duration):
+    """``drive`` a :class:`~micro.Drive` (then no ``duration``) or a velocity with a ``duration``
+    in (0, T_MAX], strictly numbers, or one ValueError naming the argument."""
+    if isinstance(drive, Drive):
+        if duration is not None:
+            raise ValueError("duration goes with a constant velocity only: a Drive sets its own length")
+        if drive.duration > T_MAX:
+            raise ValueError(f"drive must last at most {T_MAX:g}, got {drive.duration:g}")
+        return drive, None
+    V = _number("drive", drive)
+    if not (math.isfinite(V) and V >= 0.0):
+        raise ValueError(f"drive must be a micro.Drive or a finite velocity >= 0, got {_shown(drive)}")
+    if duration is None:
+        raise ValueError("duration is required when drive is a velocity")
+    duration = _number("duration", duration)
+    if not (math.isfinite(duration) and 0.0 < duration <= T_MAX):
+        raise ValueError(f"duration must be in (0, {T_MAX:g}], got {duration:g}")
+    return V, duration
+
+
+def _hold_times(hold_times) -> list[float]:
+    """The hold times as floats (a number or a non-empty sequence of numbers, each finite
+    and in [0, T_MAX]), or one ValueError naming ``hold_times``."""
+    raw = np.atleast_1d(np.asarray(hold_times, dtype=object)).ravel().tolist()
+    if not raw:
+        raise ValueError("hold_times must hold at least one hold time, got an empty sequence")
+    holds = []
+    for i, h in enumerate(raw):
+        try:
+            value = _number(f"hold_times item {i + 1}", h)
+        except ValueError:
+            raise ValueError(f"hold_times item {i + 1} of {len(raw)} must be a number, got {_shown(h)}") from None
+        if not (math.isfinite(value) and 0.0 <= value <= T_MAX):
+            raise ValueError(f"hold_times item {i + 1} of {len(raw)} must be in [0, {T_MAX:g}], got {value:g}")
+        holds.append(value)
+    return holds
 
 
 def slide_hold_slide(
@@ -479,4 +560,10 @@ def slide_hold_slide(
     """
     _check_model(model)
     numerics = _transient_method(method, numerics, "slide_hold_slide")
+    V = check_velocity(V)
+    hold_times = _hold_times(hold_times)
+    if resume is not None:
+        resume = _number("resume", resume)
+        if not (math.isfinite(resume) and 0.0 < resume <= T_MAX):
+            raise ValueError(f"resume must be in (0, {T_MAX:g}] (or None for the default), got {resume:g}")
     return fp.slide_hold_slide_fp(model, V, hold_times, numerics=numerics, convergence=convergence, resume=resume)

@@ -118,7 +118,9 @@ def _model_options(p: argparse.ArgumentParser, *, k0_list: bool = False) -> None
         g.add_argument("--k0", type=float, required=True, help=f"driving-spring stiffness, in (0, {K0_MAX:g}]")
     g.add_argument("--k1", type=float, default=0.1, help="elastic coupling, >= 0 (default 0.1)")
     g.add_argument("--k2", type=float, default=0.9, help="viscoelastic coupling, >= 0 (default 0.9)")
-    g.add_argument("--zbar", type=float, default=0.1, help="mean pinning distance, > 0 (default 0.1)")
+    g.add_argument("--zbar", type=float, default=0.1,
+                   help="mean pinning distance, > 0 (default 0.1); <= 0.38 with --dist exp (the cut at 10 "
+                        "must not lower the mean by more than 1e-10)")
     g.add_argument("--dist", choices=("exp", "delta"), default="exp",
                    help="pinning distances: exponential with cutoff 10 (default) or all equal to zbar")
     g.add_argument("--eta-u", type=float, default=1.0, help="dashpot viscosity, > 0 (default 1)")
@@ -156,9 +158,38 @@ def _refuse(args, flags, why: str) -> None:
 _MODEL_FLAGS = ("k0", "k1", "k2", "zbar", "eta_u", "f_th")
 
 
+#: The command line's exponential jumps are cut at this distance (the paper's Appendix B).
+CUTOFF = 10.0
+#: The relative amount by which the cut may lower the jumps' mean below --zbar (the tables
+#: report the mean as zbar): the renewal chain's own accuracy, ~1e-10.
+CUT_MEAN_RTOL = 1e-10
+
+
+def _zbar_max_for_cutoff() -> float:
+    """The largest --zbar whose exponential jumps, cut at ``CUTOFF``, keep their mean within
+    ``CUT_MEAN_RTOL`` of it: the mean is zbar (1 - (c/zbar) e^(-c/zbar) / (1 - e^(-c/zbar))),
+    solved for c/zbar by bisection."""
+    def deficit(r: float) -> float:   # r = c / zbar
+        return r * math.exp(-r) / -math.expm1(-r)
+    lo, hi = 1.0, 100.0               # deficit falls with r: above the tolerance at lo, below at hi
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if deficit(mid) > CUT_MEAN_RTOL else (lo, mid)
+    return CUTOFF / hi
+
+
+ZBAR_MAX_EXP = _zbar_max_for_cutoff()
+
+
 def _model(args, k0: float) -> Model:
+    if args.dist == "exp" and math.isfinite(args.zbar) and args.zbar > ZBAR_MAX_EXP:
+        mean = Exponential(args.zbar, CUTOFF).mean if args.zbar < CUTOFF else math.nan
+        raise ValueError(f"--zbar must be <= {ZBAR_MAX_EXP:.4g} with --dist exp: the jumps are cut at {CUTOFF:g}, which "
+                         f"lowers their mean, the zbar the tables report, by more than {CUT_MEAN_RTOL:g} (relative) "
+                         f"above it; got {args.zbar:g}" + (f" (mean {mean:.3g})" if mean == mean else "")
+                         + "; --dist delta has no cutoff")
     try:
-        jumps = Exponential(args.zbar, 10.0) if args.dist == "exp" else Deterministic(args.zbar)
+        jumps = Exponential(args.zbar, CUTOFF) if args.dist == "exp" else Deterministic(args.zbar)
         return Model(k0=k0, k1=args.k1, k2=args.k2, eta_u=args.eta_u, f_th=args.f_th, jumps=jumps)
     except ValueError as exc:  # (name the flag the user typed: "zbar must be ..." -> "--zbar must be ...")
         text = str(exc)
@@ -233,10 +264,14 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--method", choices=("auto", "renewal", "fp"), default="auto",
                    help="auto = renewal (default): the direct solution, ~1e-10 relative in < 1 s; fp: bisection on "
                         "Fokker-Planck runs (minutes, uncertain by the bin)")
-    c.add_argument("--V-min", type=float, default=1e-4, help="lower end of the bracket (default 1e-4)")
+    c.add_argument("--V-min", type=float, default=1e-4,
+                   help="lower end of the bracket, in [1e-6, 1e7] (default 1e-4); a V^c below it is reported "
+                        "as status 'V^c below --V-min'")
     c.add_argument("--V-max", type=float, default=None,
-                   help="upper end of the bracket (default 1e7 with --method renewal, 1e3 with fp)")
-    c.add_argument("--rel-tol", type=float, default=1e-2, help="stop when V_high/V_low - 1 <= this (default 1e-2)")
+                   help="upper end of the bracket, in [1e-6, 1e7] (default 1e7 with --method renewal, 1e3 with "
+                        "fp); a V^c above it is reported as status 'V^c above --V-max'")
+    c.add_argument("--rel-tol", type=float, default=1e-2,
+                   help="stop when V_high/V_low - 1 <= this, in (0, 1) (default 1e-2)")
     c.add_argument("--no-refine", dest="refine", action="store_false",
                    help="decide oscillations smaller than 2 eps by their size and global shocks instead of "
                         "rerunning them at eps/2 (several times faster near Vc, but Vc then carries the "
@@ -251,7 +286,7 @@ def build_parser() -> argparse.ArgumentParser:
     drive.add_argument("--schedule", help="piecewise drive V1:T1,V2:T2,... (velocity:duration, V in [0, 1e7], total T <= 1e8)")
     drive.add_argument("--shs", nargs=4, type=float, metavar=("V", "SLIDE", "HOLD", "RESUME"),
                        help="slide-hold-slide: drive at V for SLIDE, hold for HOLD, resume for RESUME")
-    r.add_argument("--duration", type=float, help="run length for --V, in (0, 1e8]")
+    r.add_argument("--duration", type=float, help="run length for --V (only), in (0, 1e8]")
     r.add_argument("--out", required=True,
                    help="output CSV (- for standard output): t,w,sigma (plus window min/max/mean)")
     return p
@@ -314,6 +349,38 @@ def _options(args, models: list[Model]):
     return fp_opts, convergence, cohort
 
 
+#: The parameters of micro.critical_velocity and the flags that set them.
+_CRITICAL_FLAGS = {"V_min": "--V-min", "V_max": "--V-max", "rel_tol": "--rel-tol"}
+
+
+def _as_flags(text: str) -> str:
+    """``text`` with the parameters of :func:`micro.critical_velocity` named as their flags."""
+    for name, flag in _CRITICAL_FLAGS.items():
+        text = re.sub(rf"\b{name}\b", flag, text)
+    return text
+
+
+@contextlib.contextmanager
+def _critical_flags():
+    """A ValueError of :func:`micro.critical_velocity` names the flags, not the parameters."""
+    try:
+        yield
+    except ValueError as exc:
+        raise ValueError(_as_flags(str(exc))) from None
+
+
+def _check_critical_range(args) -> None:
+    """``--V-min``, ``--V-max`` and ``--rel-tol`` checked before the first k0 is computed: the
+    velocities within the steady branch's range (as ``--V``), ``--V-min < --V-max``."""
+    _bounded(args.V_min, "--V-min", *V_RANGE)
+    if args.V_max is not None:
+        _bounded(args.V_max, "--V-max", *V_RANGE)
+        if not args.V_max > args.V_min:
+            raise ValueError(f"--V-max must be > --V-min, got --V-min {args.V_min:g}, --V-max {args.V_max:g}")
+    if not (math.isfinite(args.rel_tol) and 0.0 < args.rel_tol < 1.0):
+        raise ValueError(f"--rel-tol must be in (0, 1), got {args.rel_tol!r}")
+
+
 def _run(args) -> int:
     start = time.perf_counter()
     # everything is checked before anything is computed
@@ -345,25 +412,35 @@ def _run(args) -> int:
                   f"{last.regime} ({last.method}), sigma_max={last.sigma_max:.6f}, sigma_min={last.sigma_min:.6f}"
                   f"{'' if last.converged else ' (NOT converged: ' + last.message + ')'}", file=sys.stderr)
 
-        frame = sweep(models[0], velocities, method=method, numerics=numerics, convergence=convergence,
-                      on_row=row_done)
+        try:
+            frame = sweep(models[0], velocities, method=method, numerics=numerics, convergence=convergence,
+                          on_row=row_done)
+        except ValueError as exc:  # (name the flags the user typed)
+            raise ValueError(str(exc).replace("Cohort dt", "--cohort-dt").replace("Cohort h", "--cohort-h")) from None
         if not out.replaceable:
             _write_csv(frame, out)
         print(f"wrote {len(frame)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0 if frame.converged.all() else 3
     if args.command == "critical":
+        _check_critical_range(args)
         rows = []
         for i, model in enumerate(models):
-            crit = critical_velocity(model, V_min=args.V_min, V_max=args.V_max, rel_tol=args.rel_tol,
-                                     numerics=numerics, convergence=convergence, refine=args.refine,
-                                     method=args.method)
-            rows.append(crit.to_dict())
+            with _critical_flags():
+                crit = critical_velocity(model, V_min=args.V_min, V_max=args.V_max, rel_tol=args.rel_tol,
+                                         numerics=numerics, convergence=convergence, refine=args.refine,
+                                         method=args.method)
+            row = crit.to_dict()
+            row["status"], row["message"] = _as_flags(row["status"]), _as_flags(row["message"])
+            rows.append(row)
+            _write_csv(pd.DataFrame(rows), out)   # every finished row is kept, whatever comes next
             print(f"{_progress(i + 1, len(models), time.perf_counter() - start)} k0={model.k0:g}: "
-                  f"Vc={crit.Vc:.6g} ({crit.status})", file=sys.stderr)
-        _write_csv(pd.DataFrame(rows), out)
+                  f"Vc={crit.Vc:.6g} ({row['status']})", file=sys.stderr)
         print(f"wrote {len(rows)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0
     # run
+    if args.duration is not None and args.V is None:
+        raise ValueError(f"--duration goes with --V only: --{'schedule' if args.schedule else 'shs'} sets its own "
+                         "length (the sum of its durations)")
     if args.V is not None:
         if args.duration is None:
             raise ValueError("--duration is required with --V")

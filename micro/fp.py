@@ -32,7 +32,7 @@ from .grid import Grid, GridSettings
 from .params import Model
 from .protocols import Drive
 from .methods import Convergence, Numerics, check_velocity as _check_velocity
-from .results import Critical, Run, Stationary
+from .results import ABOVE, BELOW, Critical, Run, Stationary
 
 
 __all__ = ["simulate_fp", "stationary_fp", "critical_velocity_fp", "slide_hold_slide_fp"]
@@ -503,8 +503,8 @@ def critical_velocity_fp(
     or larger (within ``[V_min, V_max]``) until it changes; the bracket is then halved
     geometrically until ``V_high / V_low - 1 <= rel_tol``.  If the
     system is steady already at ``V_min`` (e.g. ``k0 >= k2``), ``Vc`` is reported as NaN
-    with status ``"no stick-slip"``; if it is stick-slip at ``V_max``, as ``inf`` with
-    status ``"above range"``.
+    with status ``"V^c below V_min"``; if it is stick-slip at ``V_max``, as ``inf`` with
+    status ``"V^c above V_max"``.
 
     V^c is where steady sliding loses stability, and each evaluation is decided from
     close to it: a run below the slowest velocity found steady so far starts from that
@@ -602,8 +602,8 @@ def critical_velocity_fp(
     while True:
         if steady:
             if V <= V_min:
-                return _reported(Critical(model, math.nan, 0.0, V_min, "no stick-slip",
-                                          f"steady already at V_min = {V_min:g}", evaluations))
+                return _reported(Critical(model, math.nan, 0.0, V_min, BELOW,
+                                          f"steady already at V_min = {V_min:g}: V^c lies below V_min", evaluations))
             V = max(V / factor, V_min)
             if regime(V) != "steady":
                 lo = V
@@ -611,8 +611,8 @@ def critical_velocity_fp(
             hi = V
         else:
             if V >= V_max:
-                return _reported(Critical(model, math.inf, V_max, math.inf, "above range",
-                                          f"not steady at V_max = {V_max:g}", evaluations))
+                return _reported(Critical(model, math.inf, V_max, math.inf, ABOVE,
+                                          f"not steady at V_max = {V_max:g}: V^c lies above V_max", evaluations))
             V = min(V * factor, V_max)
             if regime(V) == "steady":
                 hi = V

@@ -159,6 +159,16 @@ COHORT_DT = 0.01
 COHORT_CELL = 1.0 / 20.0
 
 
+#: The most delta_R cells the cohort method's grid may have (each a few doubles in several
+#: arrays; the default cell, kappa zbar / 20, gives about 160).
+COHORT_CELLS_MAX = 1e7
+
+#: The most time steps one loading phase of the cohort method may take (at about a
+#: microsecond each, a quarter of an hour per cycle, and 10-20 cycles are needed): beyond,
+#: :func:`micro.stationary` refuses before computing.
+COHORT_STEPS_MAX = 1e9
+
+
 @dataclass(frozen=True)
 class Cohort:
     """The cohort method's options (``method=micro.Cohort(...)``).
@@ -167,7 +177,7 @@ class Cohort:
     ----------
     dt : time step of the loading phase, in (0, 0.1] (default 0.01; the error is second
         order in it).
-    h : delta_R cell, in (0, kappa zbar / 2]; None: ``kappa zbar / 20``.
+    h : delta_R cell, in [90 k2 zbar / 1e7, kappa zbar / 2]; None: ``kappa zbar / 20``.
     tol : the fixed point's tolerance on sigma_max, sigma_min, sigma_before and
         sigma_after, in units of stress, in [1e-9, 1e-2] (default 2e-5).
     max_iter : most cycles the fixed-point iteration may take, >= 4.
@@ -191,11 +201,17 @@ class Cohort:
             raise ValueError(f"Cohort max_iter must be an integer >= 4, got {self.max_iter!r}")
 
     def cell(self, model: Model) -> float:
-        """The delta_R cell for ``model``, or one ValueError naming h and its range."""
+        """The delta_R cell for ``model``, or one ValueError naming h and its range: at most
+        ``kappa zbar / 2``, and at least ``90 k2 zbar / COHORT_CELLS_MAX`` (the cohort's
+        delta_R grid spans ``(k2 / kappa) 45 kappa zbar`` on each side of 0, so that many
+        cells; a finer one asked for more memory than any machine has)."""
         top = 0.5 * model.kappa * model.zbar
+        low = 90.0 * model.k2 * model.zbar / COHORT_CELLS_MAX
         h = model.kappa * model.zbar * COHORT_CELL if self.h is None else float(self.h)
-        if not h <= top:
-            raise ValueError(f"Cohort h must be in (0, kappa zbar / 2 = {top:g}], got {h:g}")
+        if not low <= h <= top:
+            raise ValueError(f"Cohort h must be in [{low:.3g}, {top:g}] (at most kappa zbar / 2; at least 90 k2 "
+                             f"zbar / {COHORT_CELLS_MAX:.0e}, the delta_R grid's span over its largest cell count), "
+                             f"got {h:g}")
         return h
 
 

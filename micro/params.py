@@ -34,7 +34,8 @@ def _number(name: str, value) -> float:
     """``value`` as a float, or one ValueError naming it: a bool (an int to Python) or a
     string is not a number here."""
     if isinstance(value, (bool, str, bytes)) or not isinstance(value, (int, float)) and not hasattr(value, "__float__"):
-        raise ValueError(f"{name} must be a number, got {value!r}")
+        shown = value.item() if isinstance(value, np.generic) else value   # 'x', not np.str_('x')
+        raise ValueError(f"{name} must be a number, got {shown!r}")
     return float(value)
 
 
@@ -315,7 +316,10 @@ class Model:
     Parameters
     ----------
     k0 : float
-        Driving-spring stiffness, in (0, 1e3 f_th / zbar] (1e4 for the paper's parameters).
+        Driving-spring stiffness, in (0, 1e3 f_th / zbar] (1e4 for the paper's parameters),
+        and small enough that fast steady sliding keeps a positive friction:
+        :math:`f^{th} - (k_0 + k_1 + k_2)\langle z^2\rangle/(2\langle z\rangle) > 0` (Eq. 6;
+        k0 < 9 for the paper's parameters).
     k1 : float
         Elastic coupling between blocks, in [0, 1e3 f_th / zbar] (default 0.1).
     k2 : float
@@ -332,8 +336,10 @@ class Model:
     Raises
     ------
     ValueError
-        If ``jumps`` is not a :class:`JumpDistribution`, or a constant is not a number (a
-        bool or a string is refused) or lies outside its range.
+        If ``jumps`` is not a :class:`JumpDistribution`, a constant is not a number (a
+        bool or a string is refused) or lies outside its range, or the steady friction at
+        :math:`V \to \infty` is not positive (the message names ``k0``, or ``zbar`` where
+        no stiffness would do).
 
     Examples
     --------
@@ -361,6 +367,26 @@ class Model:
         object.__setattr__(self, "k1", _finite_nonnegative("k1", self.k1, top))
         object.__setattr__(self, "k2", _finite_nonnegative("k2", self.k2, top))
         object.__setattr__(self, "eta_u", _finite_positive("eta_u", self.eta_u))
+        self._check_positive_friction()
+
+    def _check_positive_friction(self) -> None:
+        r"""The steady stress at :math:`V \to \infty`, :math:`f^{th} - \kappa \langle z^2\rangle /
+        (2\langle z\rangle)` (Eq. (6) of the paper for equal jumps, where the mean residual is
+        :math:`\bar z/2`; :func:`micro.analytic.sigma_fast_limit`), is the lowest steady
+        friction: it must be > 0, else fast steady sliding has a negative friction."""
+        residual = float(self.jumps.mean_residual)
+        if self.f_th - self.kappa * residual > 0.0:
+            return
+        sigma = self.f_th - self.kappa * residual
+        k0_max = self.f_th / residual - self.k1 - self.k2
+        where = (f"(the steady stress at V -> infinity, f_th - (k0 + k1 + k2) <z^2>/(2<z>), Eq. 6, must be > 0; "
+                 f"it is {sigma:g} with f_th = {self.f_th:g}, k0 = {self.k0:g}, k1 = {self.k1:g}, k2 = {self.k2:g}, "
+                 f"zbar = {self.jumps.zbar:g}, <z^2>/(2<z>) = {residual:g})")
+        if k0_max > 0.0:
+            raise ValueError(f"k0 must be < {k0_max:g} {where}")
+        # no stiffness helps: the jumps are too long for the threshold
+        zbar_max = self.jumps.zbar * (self.f_th / self.kappa) / residual
+        raise ValueError(f"zbar must be < {zbar_max:g} for these couplings {where}")
 
     @property
     def kappa(self) -> float:

@@ -55,6 +55,7 @@ from . import _renewal_kernels as RK
 from ._threads import blas_single_threaded
 from .analytic import _check_model
 from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
+from .results import ABOVE, BELOW
 
 __all__ = ["SteadySliding", "steady_sliding", "critical_velocity_renewal", "characteristic_function",
            "growth_rate_near_vc", "unstable_mode_count", "vc_small_k0"]
@@ -97,6 +98,8 @@ def _check_velocities(V) -> np.ndarray:
         v = raw.astype(float)
     except (TypeError, ValueError):
         raise ValueError(f"V must be a number or an array of numbers, got {shown}") from None
+    if v.size == 0:
+        raise ValueError("V must hold at least one velocity, got an empty array")
     bad = ~(np.isfinite(v) & (v >= V_RANGE[0]) & (v <= V_RANGE[1]))
     if np.any(bad):
         raise ValueError(f"V must be finite and in [{V_RANGE[0]:g}, {V_RANGE[1]:g}], got {float(v[bad].ravel()[0])!r}")
@@ -786,7 +789,8 @@ def critical_velocity_renewal(model: Model, *, V_min: float = 1e-4, V_max: float
     -------
     tuple
         ``(Vc, error, status, message, evaluations)``: status ``'converged'``, ``'no
-        stick-slip'`` (Vc = 0) or ``'above range'`` (Vc = inf); ``evaluations`` is a
+        stick-slip'`` (k0 >= k2, Vc = 0), ``BELOW`` = ``'V^c below V_min'`` (Vc = 0) or
+        ``ABOVE`` = ``'V^c above V_max'`` (Vc = inf); ``evaluations`` is a
         list of dicts ``V, branching_ratio, error``.
 
     Raises
@@ -802,7 +806,8 @@ def critical_velocity_renewal(model: Model, *, V_min: float = 1e-4, V_max: float
             f"(its V -> 0 limit is (k1 + k2)/(k0 + k1)), no stick-slip"), evaluations
 
     def f(log_v: float) -> float:
-        res = steady_sliding(model, math.exp(log_v), tol=tol, growth_rate=False, warn=False)
+        # exp(log(V_max)) may round above V_max (1e7 -> 10000000.000000006): clip to the range
+        res = steady_sliding(model, min(max(math.exp(log_v), V_min), V_max), tol=tol, growth_rate=False, warn=False)
         evaluations.append({"V": math.exp(log_v), "branching_ratio": float(res.branching_ratio),
                             "error": float(res.branching_error)})
         return float(res.branching_ratio) - 1.0
@@ -813,13 +818,15 @@ def critical_velocity_renewal(model: Model, *, V_min: float = 1e-4, V_max: float
     lmin, lmax = math.log(V_min), math.log(V_max)
     while f_lo <= 0.0:  # still stable: go slower
         if lo <= lmin:
-            return 0.0, 0.0, "no stick-slip", f"steady sliding stable already at V_min = {V_min:g}", evaluations
+            return 0.0, 0.0, BELOW, (f"steady sliding stable already at V_min = {V_min:g}, while k0 = {model.k0:g} "
+                                     f"< k2 = {model.k2:g} (stick-slip below V^c): V^c lies below V_min"), evaluations
         hi, f_hi = lo, f_lo
         lo = max(lo - 1.5, lmin)
         f_lo = f(lo)
     while f_hi > 0.0:  # still unstable: go faster
         if hi >= lmax:
-            return math.inf, math.inf, "above range", f"steady sliding unstable still at V_max = {V_max:g}", evaluations
+            return math.inf, math.inf, ABOVE, (f"steady sliding unstable still at V_max = {V_max:g}: V^c lies above "
+                                               f"V_max"), evaluations
         lo, f_lo = hi, f_hi
         hi = min(hi + 1.5, lmax)
         f_hi = f(hi)

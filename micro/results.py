@@ -306,6 +306,12 @@ class Stationary:
         }
 
 
+#: The statuses of a V^c search that ends at an end of its range (the command line names
+#: --V-min and --V-max instead).
+BELOW = "V^c below V_min"
+ABOVE = "V^c above V_max"
+
+
 @dataclass
 class Critical:
     """The critical velocity V^c, with ``V_low`` (stick-slip) and ``V_high`` (steady) around
@@ -321,16 +327,19 @@ class Critical:
     Vc : float
         V^c: the root of b(V) = 1, or the geometric mean of the bisection's bracket; NaN
         with status ``"no stick-slip"`` (there is no critical velocity; rsf's encoding of
-        "stable at every V" too), ``inf`` with ``"above range"``.
+        "stable at every V" too) and with ``"V^c below V_min"`` (it lies below the range),
+        ``inf`` with ``"V^c above V_max"``.
     V_low : float
         Below V^c (stick-slip): ``Vc`` minus its error, or the bracket's lower end; 0
-        with ``"no stick-slip"``, ``V_max`` with ``"above range"``.
+        with ``"no stick-slip"`` and ``"V^c below V_min"``, ``V_max`` with ``"V^c above V_max"``.
     V_high : float
         Above V^c (steady): ``Vc`` plus its error, or the bracket's upper end;
-        ``V_min`` with ``"no stick-slip"``, ``inf`` with ``"above range"``.
+        ``V_min`` with ``"no stick-slip"`` and ``"V^c below V_min"``, ``inf`` with
+        ``"V^c above V_max"``.
     status : str
-        ``"converged"``, ``"no stick-slip"`` (steady sliding is stable at every V, or
-        already at ``V_min``) or ``"above range"`` (still stick-slip at ``V_max``).
+        ``"converged"``, ``"no stick-slip"`` (steady sliding is stable at every V:
+        ``k0 >= k2``), ``"V^c below V_min"`` (stable already at ``V_min``, though unstable
+        at smaller V) or ``"V^c above V_max"`` (still stick-slip at ``V_max``).
     message : str
         How the search ended.
     evaluations : list of dict

@@ -32,6 +32,16 @@ logger = logging.getLogger(__name__)
 _PROGRESS_CYCLES = 1000  # limit_cycle logs its progress (INFO) every this many cycles
 
 
+def _checked(options, initial) -> tuple[SolverOptions, InitialState]:
+    """``options`` and ``initial`` of their types (None: the defaults), or one ValueError
+    naming the argument (``options='fast'`` was taken and failed later)."""
+    if options is not None and not isinstance(options, SolverOptions):
+        raise ValueError(f"options must be an rsf.SolverOptions (or None), got {options!r}")
+    if initial is not None and not isinstance(initial, InitialState):
+        raise ValueError(f"initial must be an rsf.InitialState (or None), got {initial!r}")
+    return options or SolverOptions(), initial or InitialState()
+
+
 def _protocol_from(V: float | None, protocol: Protocol | None) -> Protocol:
     if protocol is not None and V is not None:
         raise ValueError("give either V (constant driving) or protocol, not both")
@@ -123,9 +133,8 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
     if t_end > T_END_MAX:
         raise ValueError(f"t_end must be <= {T_END_MAX:g} (rsf.params.T_END_MAX), got {t_end:g}")
     protocol = _protocol_from(V, protocol)
-    initial = initial or InitialState()
+    options, initial = _checked(options, initial)
     initial = initial.resolved(InitialState.DEFAULT_PERTURBATION if protocol.is_constant else 0.0)
-    options = options or SolverOptions()
     t_eval = _check_t_eval(t_eval, t_end)
     if model.a == 0.0 and protocol.is_linear:
         raise ValueError("a sampled (linearly interpolated) load history needs a direct "
@@ -234,11 +243,11 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
     V = positive("V", V)
     model.check_resolved(V)
-    options = options or SolverOptions()
+    options, initial = _checked(options, initial)
     if model.second_state is not None and options.accelerate:
         # the cycle map has two dimensions: no one-variable extrapolation
         options = replace(options, accelerate=False)
-    initial = (initial or InitialState()).resolved(InitialState.DEFAULT_PERTURBATION)
+    initial = initial.resolved(InitialState.DEFAULT_PERTURBATION)
     started = time.perf_counter()
     engine = make_engine(model, Protocol.constant(V), options, record=False, stop_at_steady=True)
     engine.start(initial)
@@ -313,6 +322,7 @@ def sweep(model: SpringSlider, velocities: Iterable[float], *, options: SolverOp
         raise ValueError("velocities must hold at least one velocity > 0")
     if not isinstance(model, SpringSlider):
         raise ValueError(f"model must be an rsf.SpringSlider, got {model!r}")
+    _checked(options, initial)
     for V in vel:     # every velocity before the first is computed
         model.check_resolved(V)
     results = []

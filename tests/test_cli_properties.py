@@ -115,3 +115,82 @@ def test_bad_options_many_examples(tmp_path_factory, case, value):
     main, head, option = case
     out = tmp_path_factory.mktemp("many") / "out.csv"
     _check_refused(main, head + [option, value, "--out", str(out)], option, out)
+
+
+# --- issue 54: ranges that exclude degenerate physics, and truthful statuses ------------------
+def _log_floats(lo: float, hi: float):
+    """Floats spread over the decades from ``lo`` to ``hi`` (as text)."""
+    return st.floats(math.log10(lo), math.log10(hi)).map(lambda e: repr(10.0 ** e))
+
+
+#: (command, command line before the option, option, values that must be refused): each
+#: refused at once, naming the option, whatever the other options (the defaults here).
+DEGENERATE = [
+    (rsf.cli.main, ["sweep", "--k0", "0.1", "--V", "0.5"], "--Dc", _log_floats(1e-300, 1e-17)),
+    (rsf.cli.main, ["sweep", "--k0", "0.1", "--V", "0.5"], "--A", _log_floats(1e15, 1e300)),
+    (rsf.cli.main, ["sweep", "--k0", "0.1", "--V", "0.5"], "--B", _log_floats(1e-300, 1e-60)),
+    (rsf.cli.main, ["sweep", "--k0", "0.1", "--V", "0.5"], "--mu-inf", _log_floats(1e15, 1e300)),
+    (rsf.cli.main, ["sweep", "--k0", "0.1", "--V", "0.5"], "--mu-inf",
+     st.floats(-1e300, -1e-300).map(repr)),
+    (rsf.cli.main, ["run", "--k0", "0.1", "--V", "0.5", "--t-end", "5"], "--Dc", _log_floats(1e-300, 1e-17)),
+    (rsf.cli.main, ["sweep", "--law", "viscoelastic", "--k0", "0.1", "--V", "0.5"], "--zbar",
+     _log_floats(2.0, 1e300)),
+    (micro.cli.main, ["steady", "--V", "1", "--k0", "0.1"], "--k0", st.floats(9.0, 1000.0).map(repr)),
+    (micro.cli.main, ["steady", "--k0", "0.1", "--V", "1"], "--zbar", st.floats(0.381, 9.99).map(repr)),
+    (micro.cli.main, ["critical", "--k0", "0.1"], "--V-min",
+     st.one_of(_log_floats(1e-300, 9e-7), _log_floats(1.1e7, 1e300), st.just("0"))),
+    (micro.cli.main, ["critical", "--k0", "0.1"], "--V-max", _log_floats(1.1e7, 1e300)),
+    (micro.cli.main, ["sweep", "--k0", "0.1", "--V", "0.5"], "--cohort-dt", _log_floats(1e-300, 1e-10)),
+    (micro.cli.main, ["sweep", "--k0", "0.1", "--V", "0.5"], "--cohort-h", _log_floats(1e-300, 8e-7)),
+    (micro.cli.main, ["run", "--k0", "0.1", "--shs", "1", "1", "1", "1"], "--duration",
+     st.floats(1e-3, 1e8).map(repr)),
+    (compare.cli.main, ["--quick", "--no-cache", "--no-progress"], "--dc",
+     st.one_of(_log_floats(1e-300, 4.9e-3), _log_floats(0.51, 1e300))),
+]
+
+
+@QUICK
+@given(case=st.sampled_from(range(len(DEGENERATE))), data=st.data())
+def test_degenerate_physics_is_refused_at_once_naming_the_option(tmp_path_factory, case, data):
+    main, head, option, values = DEGENERATE[case]
+    value = data.draw(values)
+    out = tmp_path_factory.mktemp("degenerate") / ("report" if main is compare.cli.main else "out.csv")
+    _check_refused(main, head + [option, value, "--out", str(out)], option, out)
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(V_min=_log_floats(1e-4, 1e3))
+def test_micro_critical_says_where_vc_lies_against_the_range(tmp_path_factory, V_min):
+    # k0 = 0.1: V^c = 0.7275; a range that starts above it says so, never 'no stick-slip'
+    out = tmp_path_factory.mktemp("critical") / "out.csv"
+    status, err = _run(micro.cli.main, ["critical", "--k0", "0.1", "--V-min", V_min, "--out", str(out)])
+    assert status == 0, err
+    row = pd.read_csv(out).iloc[0]
+    if float(V_min) < 0.727:
+        assert row.status == "converged" and row.Vc == pytest.approx(0.72750434, rel=1e-6)
+    elif float(V_min) > 0.728:
+        assert row.status == "V^c below --V-min" and math.isnan(row.Vc)
+
+
+@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(k0=_log_floats(1e-9, 7e-9))
+def test_micro_critical_above_the_range_is_a_status_and_keeps_the_rows(tmp_path_factory, k0):
+    out = tmp_path_factory.mktemp("critical") / "out.csv"
+    status, err = _run(micro.cli.main, ["critical", "--k0", f"0.1,{k0}", "--out", str(out)])
+    assert status == 0, err
+    frame = pd.read_csv(out)
+    assert list(frame.status) == ["converged", "V^c above --V-max"] and math.isinf(frame.Vc[1])
+
+
+@QUICK
+@given(spelling=st.sampled_from(["same", "relative", "dot", "link"]))
+def test_rsf_run_refuses_out_and_events_on_one_file(tmp_path_factory, spelling, monkeypatch):
+    folder = tmp_path_factory.mktemp("same")
+    out = folder / "o.csv"
+    other = {"same": str(out), "relative": "o.csv", "dot": "./o.csv", "link": str(folder / "l.csv")}[spelling]
+    if spelling == "link":
+        (folder / "l.csv").symlink_to(out)
+    monkeypatch.chdir(folder)
+    status, err = _run(rsf.cli.main, ["run", "--k0", "0.3", "--V", "0.05", "--t-end", "2", "--out", str(out),
+                                      "--events", other])
+    assert status == 2 and "--out and --events name the same file" in err and not out.exists()

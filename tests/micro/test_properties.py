@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 
 import micro
 
-QUICK = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-MORE = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+QUICK = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+MORE = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 
 GOOD = dict(k0=0.1, k1=0.1, k2=0.9, eta_u=1.0, f_th=1.0)
 #: values no parameter accepts: non-finite, non-numbers, bools
@@ -82,11 +82,14 @@ def test_bad_cohort_options_are_one_error_naming_them(name, value):
 
 
 def _models():
-    return st.builds(
-        lambda k0, k1, k2, eta_u, f_th, zbar: micro.Model(k0=k0, k1=k1, k2=k2, eta_u=eta_u, f_th=f_th,
-                                                          jumps=micro.Exponential(zbar, 100.0 * zbar)),
+    # only models whose fast steady sliding keeps a positive friction, f_th > kappa zbar
+    # (Eq. 6; the others are refused since issue 54)
+    params = st.fixed_dictionaries(dict(
         k0=st.floats(1e-4, 10.0), k1=st.floats(0.0, 1.0), k2=st.floats(0.0, 1.0), eta_u=st.floats(0.2, 5.0),
-        f_th=st.floats(0.5, 3.0), zbar=st.floats(0.02, 0.5))
+        f_th=st.floats(0.5, 3.0), zbar=st.floats(0.02, 0.5)))
+    return params.filter(lambda p: p["f_th"] > 1.001 * (p["k0"] + p["k1"] + p["k2"]) * p["zbar"]).map(
+        lambda p: micro.Model(k0=p["k0"], k1=p["k1"], k2=p["k2"], eta_u=p["eta_u"], f_th=p["f_th"],
+                              jumps=micro.Exponential(p["zbar"], 100.0 * p["zbar"])))
 
 
 def _check_branch(model, V):

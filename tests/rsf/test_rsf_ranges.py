@@ -118,3 +118,12 @@ def test_run_within_the_probe_is_the_whole_run(tmp_path, capsys):
     assert "too many events" not in capsys.readouterr().err
     import pandas as pd
     assert math.isclose(pd.read_csv(out).t.iloc[-1], 100.0)
+
+
+# --- D25: an argument of another type ------------------------------------------------------
+def test_rsf_options_of_another_type_are_refused():
+    model = rsf.SpringSlider(k0=0.1)
+    with pytest.raises(ValueError, match=r"^options must be an rsf.SolverOptions \(or None\), got 'fast'"):
+        rsf.simulate(model, 0.5, t_end=1.0, options="fast")
+    with pytest.raises(ValueError, match=r"^initial must be an rsf.InitialState"):
+        rsf.limit_cycle(model, 0.5, initial=3)
