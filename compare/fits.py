@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import brentq, curve_fit, least_squares, minimize_scalar
+from scipy.optimize import curve_fit, least_squares, minimize_scalar
 
 import rsf
 

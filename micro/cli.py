@@ -11,6 +11,7 @@ is an error.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import math
 import re
