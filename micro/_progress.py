@@ -1,0 +1,105 @@
+"""Progress of long computations, and prompt returns to Python for Ctrl-C.
+
+Library code marks what it is doing with :func:`stage` (a text, or a function giving
+one, e.g. the simulated time so far) and calls :func:`beat` from its inner loops (a
+cheap check: nothing happens unless a caller asked for progress).  A caller -- the
+command line -- installs a callback with :func:`reporting`; at most every ``interval``
+seconds a beat then calls it with the stages' texts joined by ``" > "``.  Without
+:func:`reporting` a beat costs one context-variable lookup.
+
+Ctrl-C needs no help from here: Python raises KeyboardInterrupt in the main thread at
+its next bytecode, so every long loop must come back to Python often (the
+Fokker-Planck kernel runs in chunks of bounded wall time, :data:`CHUNK_SECONDS`).
+
+The same module is ``rsf._progress`` (micro and rsf are independent packages and neither
+imports the other).
+"""
+from __future__ import annotations
+
+import contextlib
+import time
+from contextvars import ContextVar
+from typing import Callable, Iterator, Union
+
+__all__ = ["CHUNK_SECONDS", "Interrupted", "beat", "stage", "reporting"]
+
+Text = Union[str, Callable[[], str]]
+
+#: Wall time a compiled loop may run before it returns to Python (for Ctrl-C and progress).
+CHUNK_SECONDS = 0.2
+
+
+class Interrupted(KeyboardInterrupt):
+    """A KeyboardInterrupt (Ctrl-C) that carries what was computed before it, as keyword
+    arguments (e.g. ``records``, or ``run``: a partial :class:`~micro.results.Run`), for a
+    caller that keeps them."""
+
+    def __init__(self, **partial) -> None:
+        super().__init__()
+        self.partial = partial
+
+
+class _Reporter:
+    """The installed callback, the stack of stages and the time of the next report."""
+
+    def __init__(self, callback: Callable[[str, float], None], first: float, interval: float,
+                 longest: float) -> None:
+        self.callback = callback
+        self.start = time.monotonic()
+        self.due = self.start + first
+        self.interval = interval
+        self.longest = longest
+        self.stages: list[Text] = []
+
+    def emit(self, now: float) -> None:
+        parts = []
+        for s in self.stages:
+            try:
+                parts.append(s() if callable(s) else s)
+            except Exception:  # a stage's text must never break the computation
+                continue
+        self.due = now + self.interval
+        self.interval = min(2.0 * self.interval, self.longest)
+        if parts:
+            self.callback(" > ".join(p for p in parts if p), now - self.start)
+
+
+_REPORTER: ContextVar[_Reporter | None] = ContextVar("micro_progress", default=None)
+
+
+def beat() -> None:
+    """Report the current stages if a report is due (call it from long loops)."""
+    rep = _REPORTER.get()
+    if rep is not None:
+        now = time.monotonic()
+        if now >= rep.due:
+            rep.emit(now)
+
+
+@contextlib.contextmanager
+def stage(text: Text) -> Iterator[None]:
+    """Within the block the progress text includes ``text`` (a string, or a function
+    called at each report)."""
+    rep = _REPORTER.get()
+    if rep is None:
+        yield
+        return
+    rep.stages.append(text)
+    try:
+        beat()
+        yield
+    finally:
+        rep.stages.pop()
+
+
+@contextlib.contextmanager
+def reporting(callback: Callable[[str, float], None], *, first: float = 0.5, interval: float = 1.0,
+              longest: float = 1.0) -> Iterator[None]:
+    """Within the block, beats call ``callback(text, elapsed_seconds)``: the first time
+    ``first`` seconds after entering, then every ``interval`` seconds, the interval
+    doubling up to ``longest``."""
+    token = _REPORTER.set(_Reporter(callback, first, interval, max(longest, interval)))
+    try:
+        yield
+    finally:
+        _REPORTER.reset(token)
