@@ -4,8 +4,9 @@ Library code marks what it is doing with :func:`stage` (a text, or a function gi
 one, e.g. the simulated time so far) and calls :func:`beat` from its inner loops (a
 cheap check: nothing happens unless a caller asked for progress).  A caller -- the
 command line -- installs a callback with :func:`reporting`; at most every ``interval``
-seconds a beat then calls it with the stages' texts joined by ``" > "``.  Without
-:func:`reporting` a beat costs one context-variable lookup.
+seconds a beat then calls it with the stages' texts joined by ``" > "`` (and a watcher
+thread does, should the main thread not beat in time: while compiling, or in a long
+solve).  Without :func:`reporting` a beat costs one context-variable lookup.
 
 Ctrl-C needs no help from here: Python raises KeyboardInterrupt in the main thread at
 its next bytecode, so every long loop must come back to Python often (the
@@ -17,6 +18,7 @@ imports the other).
 from __future__ import annotations
 
 import contextlib
+import threading
 import time
 from contextvars import ContextVar
 from typing import Callable, Iterator, Union
@@ -50,18 +52,33 @@ class _Reporter:
         self.interval = interval
         self.longest = longest
         self.stages: list[Text] = []
+        self.lock = threading.Lock()
 
     def emit(self, now: float) -> None:
-        parts = []
-        for s in self.stages:
-            try:
-                parts.append(s() if callable(s) else s)
-            except Exception:  # a stage's text must never break the computation
-                continue
-        self.due = now + self.interval
-        self.interval = min(2.0 * self.interval, self.longest)
-        if parts:
-            self.callback(" > ".join(p for p in parts if p), now - self.start)
+        if not self.lock.acquire(blocking=False):
+            return  # (the other thread is reporting)
+        try:
+            if now < self.due:
+                return
+            parts = []
+            for s in list(self.stages):
+                try:
+                    parts.append(s() if callable(s) else s)
+                except Exception:  # a stage's text must never break the computation
+                    continue
+            self.due = now + self.interval
+            self.interval = min(2.0 * self.interval, self.longest)
+            self.callback(" > ".join(p for p in parts if p) or "starting", now - self.start)
+        finally:
+            self.lock.release()
+
+    def watch(self, stop: threading.Event) -> None:
+        """Report when due even while the main thread does not beat (compiling, a long
+        solve): the texts are read from this thread then."""
+        while not stop.wait(0.1):
+            now = time.monotonic()
+            if now >= self.due:
+                self.emit(now)
 
 
 _REPORTER: ContextVar[_Reporter | None] = ContextVar("micro_progress", default=None)
@@ -98,8 +115,13 @@ def reporting(callback: Callable[[str, float], None], *, first: float = 0.5, int
     """Within the block, beats call ``callback(text, elapsed_seconds)``: the first time
     ``first`` seconds after entering, then every ``interval`` seconds, the interval
     doubling up to ``longest``."""
-    token = _REPORTER.set(_Reporter(callback, first, interval, max(longest, interval)))
+    rep = _Reporter(callback, first, interval, max(longest, interval))
+    token = _REPORTER.set(rep)
+    stop = threading.Event()
+    watcher = threading.Thread(target=rep.watch, args=(stop,), name="progress", daemon=True)
+    watcher.start()
     try:
         yield
     finally:
+        stop.set()
         _REPORTER.reset(token)

@@ -24,6 +24,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ._progress import Interrupted, reporting
 from .stability import critical_velocity
 from .laws import (PAPER_A, PAPER_B, PAPER_DC, PAPER_K0_MAX, HyperbolicLaw, LogLaw, TabulatedLaw,
                    ViscoelasticLaw)
@@ -547,60 +548,102 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(_option_values(sys.argv[1:] if argv is None else list(argv), parser))
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    kept: list[str] = []  # what a Ctrl-C leaves on disk
     try:
-        # everything is checked before anything is computed
-        _check_out(args.out, "--out")
-        _check_out(getattr(args, "events", None), "--events")
-        _check_distinct(args.out, getattr(args, "events", None))
-        _check_magnitudes(args)
-        _check_law_options(args)
-        if args.command == "critical":
-            import pandas as pd
-
-            results = [critical_velocity(_model(args, k0)) for k0 in args.k0]
-            for r in results:
-                if r.status != "unstable band":
-                    print(f"k0={r.k0:g}: {r.status} (Vc = {r.Vc:g})", file=sys.stderr)
-            frame = pd.concat([r.to_frame() for r in results], ignore_index=True)
-            _write(frame, args.out)
-            return 0
-        model = _model(args, args.k0)
-        options = _options(args)
-        if args.command == "sweep":
-            if (args.V is None) == (args.V_range is None):
-                raise ValueError("give exactly one of --V and --V-range")
-            if args.V is not None:
-                velocities = args.V
-            else:
-                vmin, vmax, n = args.V_range
-                velocities = np.geomspace(vmin, vmax, int(n))
-            if isinstance(model.law, TabulatedLaw):
-                model.law.check_velocities(velocities, "--V")
-            result = sweep(model, velocities, options=options, progress=args.verbose)
-            _write(result.to_frame(), args.out)
-            if not result.all_converged:
-                print(f"warning: {result.message}", file=sys.stderr)
-                return 3
-            return 0
-        V, protocol = _protocol(args)
-        t_eval = _t_eval(args)
-        _out_dt(args, 0)
-        if isinstance(model.law, TabulatedLaw):
-            model.law.check_velocities(_driving_velocities(V, protocol), "the driving velocity V")
-        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
-                        t_eval=t_eval)
-        steps = traj.t.size
-        out_dt = _out_dt(args, steps)
-        traj = traj.thinned(out_dt)
-        note = "" if traj.t.size == steps else (f" (of {steps} integrator steps: one row per --out-dt = "
-                                                f"{out_dt:g} between events; --out-dt 0 writes them all)")
-        _write(traj.to_frame(), args.out, note)
-        if args.events:
-            _write(traj.events_frame(), args.events)
-        if not traj.success:
-            print(f"warning: {traj.message}", file=sys.stderr)
-            return 3
-        return 0
+        with reporting(_progress_line(f"rsf {args.command}"), first=0.5, interval=1.0, longest=10.0):
+            return _main(args, kept)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"interrupted: {kept[-1] if kept else 'nothing was finished, nothing written'}", file=sys.stderr)
+        return 130
+
+
+def _progress_line(prefix: str):
+    """The command line's progress callback: one line on stderr per report (every second
+    at first, then every 2, 4, ... up to 10 seconds)."""
+    def show(text: str, elapsed: float) -> None:
+        print(f"{prefix}: {text} [{elapsed:.0f} s]", file=sys.stderr, flush=True)
+    return show
+
+
+def _kept(frame, out: str | None, what: str, kept: list[str]) -> None:
+    """After a Ctrl-C: write ``frame`` (the finished part) to ``out`` and say so in ``kept``."""
+    if frame is None or not len(frame):
+        return
+    _write(frame, out)
+    kept.append(f"{what} written to {out or 'standard output'}")
+
+
+def _main(args: argparse.Namespace, kept: list[str]) -> int:
+    """The command of ``args``; raises ValueError for bad input."""
+    # everything is checked before anything is computed
+    _check_out(args.out, "--out")
+    _check_out(getattr(args, "events", None), "--events")
+    _check_distinct(args.out, getattr(args, "events", None))
+    _check_magnitudes(args)
+    _check_law_options(args)
+    if args.command == "critical":
+        import pandas as pd
+
+        results = [critical_velocity(_model(args, k0)) for k0 in args.k0]
+        for r in results:
+            if r.status != "unstable band":
+                print(f"k0={r.k0:g}: {r.status} (Vc = {r.Vc:g})", file=sys.stderr)
+        frame = pd.concat([r.to_frame() for r in results], ignore_index=True)
+        _write(frame, args.out)
+        return 0
+    model = _model(args, args.k0)
+    options = _options(args)
+    if args.command == "sweep":
+        if (args.V is None) == (args.V_range is None):
+            raise ValueError("give exactly one of --V and --V-range")
+        if args.V is not None:
+            velocities = args.V
+        else:
+            vmin, vmax, n = args.V_range
+            velocities = np.geomspace(vmin, vmax, int(n))
+        if isinstance(model.law, TabulatedLaw):
+            model.law.check_velocities(velocities, "--V")
+        try:
+            result = sweep(model, velocities, options=options, progress=args.verbose)
+        except Interrupted as stop:
+            done = stop.partial.get("result")
+            _kept(done.to_frame() if done else None, args.out,
+                  f"{len(done.results) if done else 0} of {len(velocities)} rows finished and", kept)
+            raise
+        _write(result.to_frame(), args.out)
+        if not result.all_converged:
+            print(f"warning: {result.message}", file=sys.stderr)
+            return 3
+        return 0
+    V, protocol = _protocol(args)
+    t_eval = _t_eval(args)
+    _out_dt(args, 0)
+    if isinstance(model.law, TabulatedLaw):
+        model.law.check_velocities(_driving_velocities(V, protocol), "the driving velocity V")
+    try:
+        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
+                        t_eval=t_eval)
+    except Interrupted as stop:
+        part = stop.partial.get("trajectory")
+        if part is not None and part.t.size:
+            part = part.thinned(_out_dt(args, part.t.size))
+            _kept(part.to_frame(), args.out, f"stopped at t = {part.t[-1]:.6g} of {args.t_end:g}; "
+                                             f"the {part.t.size} rows so far", kept)
+            if args.events:
+                _kept(part.events_frame(), args.events, "the events so far", kept)
+        raise
+    steps = traj.t.size
+    out_dt = _out_dt(args, steps)
+    traj = traj.thinned(out_dt)
+    note = "" if traj.t.size == steps else (f" (of {steps} integrator steps: one row per --out-dt = "
+                                            f"{out_dt:g} between events; --out-dt 0 writes them all)")
+    _write(traj.to_frame(), args.out, note)
+    if args.events:
+        _write(traj.events_frame(), args.events)
+    if not traj.success:
+        print(f"warning: {traj.message}", file=sys.stderr)
+        return 3
+    return 0
