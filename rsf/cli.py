@@ -312,7 +312,7 @@ def _options(args: argparse.Namespace) -> SolverOptions:
                              v_max=args.v_max, max_rhs_evals=args.max_rhs_evals)
 
 
-def _write(frame, out: str | None, note: str = "") -> None:
+def _write(frame, out: str | None, note: str = "", *, quiet: bool = False) -> None:
     """To standard output, or atomically (:func:`rsf.results.write_atomically`: the umask,
     an existing file's mode and a symbolic link are respected).  The count of rows goes to
     standard error, so that standard output carries nothing but data."""
@@ -325,7 +325,8 @@ def _write(frame, out: str | None, note: str = "") -> None:
             frame.to_csv(f, index=False)
 
     write_atomically(out, fill)
-    print(f"wrote {len(frame)} rows to {out}{note}", file=sys.stderr)
+    if not quiet:
+        print(f"wrote {len(frame)} rows to {out}{note}", file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -572,7 +573,7 @@ def _kept(frame, out: str | None, what: str, kept: list[str]) -> None:
     """After a Ctrl-C: write ``frame`` (the finished part) to ``out`` and say so in ``kept``."""
     if frame is None or not len(frame):
         return
-    _write(frame, out)
+    _write(frame, out, quiet=True)  # (the Ctrl-C's one line says it)
     kept.append(f"{what} written to {out or 'standard output'}")
 
 
@@ -630,10 +631,11 @@ def _main(args: argparse.Namespace, kept: list[str]) -> int:
         part = stop.partial.get("trajectory")
         if part is not None and part.t.size:
             part = part.thinned(_out_dt(args, part.t.size))
-            _kept(part.to_frame(), args.out, f"stopped at t = {part.t[-1]:.6g} of {args.t_end:g}; "
-                                             f"the {part.t.size} rows so far", kept)
             if args.events:
-                _kept(part.events_frame(), args.events, "the events so far", kept)
+                _write(part.events_frame(), args.events, quiet=True)
+            _kept(part.to_frame(), args.out, f"stopped at t = {part.t[-1]:.6g} of {args.t_end:g}; the "
+                                             f"{part.t.size} rows so far"
+                                             + (f" (and the events, to {args.events})" if args.events else ""), kept)
         raise
     steps = traj.t.size
     out_dt = _out_dt(args, steps)
