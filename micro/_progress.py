@@ -68,7 +68,9 @@ class _Reporter:
                     continue
             self.due = now + self.interval
             self.interval = min(2.0 * self.interval, self.longest)
-            self.callback(" > ".join(p for p in parts if p) or "starting", now - self.start)
+            text = " > ".join(p for p in parts if p)
+            if text:  # (nothing before the first stage: checking the input prints no progress)
+                self.callback(text, now - self.start)
         finally:
             self.lock.release()
 
@@ -110,7 +112,7 @@ def stage(text: Text) -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def reporting(callback: Callable[[str, float], None], *, first: float = 0.5, interval: float = 1.0,
+def reporting(callback: Callable[[str, float], None], *, first: float = 0.2, interval: float = 1.0,
               longest: float = 1.0) -> Iterator[None]:
     """Within the block, beats call ``callback(text, elapsed_seconds)``: the first time
     ``first`` seconds after entering, then every ``interval`` seconds, the interval

@@ -295,7 +295,7 @@ def main(argv: list[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     kept: list[str] = []  # what a Ctrl-C leaves on disk, as the commands write it
     try:
-        with reporting(_progress_line(f"micro {args.command}"), first=0.5, interval=1.0, longest=10.0):
+        with reporting(_progress_line(f"micro {args.command}"), first=0.2, interval=1.0, longest=10.0):
             return _run(args, kept)
     except (ValueError, argparse.ArgumentTypeError) as exc:
         print(f"error: {exc}", file=sys.stderr)

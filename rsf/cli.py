@@ -551,7 +551,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     kept: list[str] = []  # what a Ctrl-C leaves on disk
     try:
-        with reporting(_progress_line(f"rsf {args.command}"), first=0.5, interval=1.0, longest=10.0):
+        with reporting(_progress_line(f"rsf {args.command}"), first=0.2, interval=1.0, longest=10.0):
             return _main(args, kept)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
