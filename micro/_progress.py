@@ -11,6 +11,7 @@ solve).  Without :func:`reporting` a beat costs one context-variable lookup.
 Ctrl-C needs no help from here: Python raises KeyboardInterrupt in the main thread at
 its next bytecode, so every long loop must come back to Python often (the
 Fokker-Planck kernel runs in chunks of bounded wall time, :data:`CHUNK_SECONDS`).
+:class:`Interrupted` carries the work done so far up to a caller that keeps it.
 
 The same module is ``rsf._progress`` (micro and rsf are independent packages and neither
 imports the other).
@@ -33,8 +34,9 @@ CHUNK_SECONDS = 0.2
 
 class Interrupted(KeyboardInterrupt):
     """A KeyboardInterrupt (Ctrl-C) that carries what was computed before it, as keyword
-    arguments (e.g. ``records``, or ``run``: a partial :class:`~micro.results.Run`), for a
-    caller that keeps them."""
+    arguments (``records`` and ``shocks`` from :meth:`micro.grid.Grid.advance`; ``run``, a
+    partial :class:`~micro.results.Run`, from :func:`micro.fp.simulate_fp`), for a caller
+    that keeps them."""
 
     def __init__(self, **partial) -> None:
         super().__init__()

@@ -9,8 +9,9 @@ thread does, should the main thread not beat in time: while compiling, or in a l
 solve).  Without :func:`reporting` a beat costs one context-variable lookup.
 
 Ctrl-C needs no help from here: Python raises KeyboardInterrupt in the main thread at
-its next bytecode, so every long loop must come back to Python often (the
-the integrators call back into Python at every step or root).
+its next bytecode, so every long loop must come back to Python often (the integrators
+call back into Python at every step or root).  :class:`Interrupted` carries the work done
+so far up to a caller that keeps it.
 
 The same module is ``micro._progress`` (micro and rsf are independent packages and neither
 imports the other).
@@ -29,8 +30,9 @@ Text = Union[str, Callable[[], str]]
 
 class Interrupted(KeyboardInterrupt):
     """A KeyboardInterrupt (Ctrl-C) that carries what was computed before it, as keyword
-    arguments (e.g. ``trajectory``: a partial :class:`~rsf.results.Trajectory`, or ``results``: the finished points of a sweep), for a
-    caller that keeps them."""
+    arguments (``trajectory``: a partial :class:`~rsf.results.Trajectory`; ``result``: a
+    :class:`~rsf.results.SweepResult` of the finished points, or None), for a caller that
+    keeps them."""
 
     def __init__(self, **partial) -> None:
         super().__init__()
