@@ -552,10 +552,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     kept: list[str] = []  # what a Ctrl-C leaves on disk
     try:
         with reporting(_progress_line(f"rsf {args.command}"), first=0.2, interval=1.0, longest=10.0):
-            return _main(args, kept)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+            return _run(args, kept)
     except KeyboardInterrupt:
         print(f"interrupted: {kept[-1] if kept else 'nothing was finished, nothing written'}", file=sys.stderr)
         return 130
@@ -577,75 +574,79 @@ def _kept(frame, out: str | None, what: str, kept: list[str]) -> None:
     kept.append(f"{what} written to {out or 'standard output'}")
 
 
-def _main(args: argparse.Namespace, kept: list[str]) -> int:
-    """The command of ``args``; raises ValueError for bad input."""
-    # everything is checked before anything is computed
-    _check_out(args.out, "--out")
-    _check_out(getattr(args, "events", None), "--events")
-    _check_distinct(args.out, getattr(args, "events", None))
-    _check_magnitudes(args)
-    _check_law_options(args)
-    if args.command == "critical":
-        import pandas as pd
+def _run(args: argparse.Namespace, kept: list[str]) -> int:
+    """The command of ``args`` (``kept`` gets a line saying what is on disk, for a Ctrl-C)."""
+    try:
+        # everything is checked before anything is computed
+        _check_out(args.out, "--out")
+        _check_out(getattr(args, "events", None), "--events")
+        _check_distinct(args.out, getattr(args, "events", None))
+        _check_magnitudes(args)
+        _check_law_options(args)
+        if args.command == "critical":
+            import pandas as pd
 
-        results = [critical_velocity(_model(args, k0)) for k0 in args.k0]
-        for r in results:
-            if r.status != "unstable band":
-                print(f"k0={r.k0:g}: {r.status} (Vc = {r.Vc:g})", file=sys.stderr)
-        frame = pd.concat([r.to_frame() for r in results], ignore_index=True)
-        _write(frame, args.out)
-        return 0
-    model = _model(args, args.k0)
-    options = _options(args)
-    if args.command == "sweep":
-        if (args.V is None) == (args.V_range is None):
-            raise ValueError("give exactly one of --V and --V-range")
-        if args.V is not None:
-            velocities = args.V
-        else:
-            vmin, vmax, n = args.V_range
-            velocities = np.geomspace(vmin, vmax, int(n))
+            results = [critical_velocity(_model(args, k0)) for k0 in args.k0]
+            for r in results:
+                if r.status != "unstable band":
+                    print(f"k0={r.k0:g}: {r.status} (Vc = {r.Vc:g})", file=sys.stderr)
+            frame = pd.concat([r.to_frame() for r in results], ignore_index=True)
+            _write(frame, args.out)
+            return 0
+        model = _model(args, args.k0)
+        options = _options(args)
+        if args.command == "sweep":
+            if (args.V is None) == (args.V_range is None):
+                raise ValueError("give exactly one of --V and --V-range")
+            if args.V is not None:
+                velocities = args.V
+            else:
+                vmin, vmax, n = args.V_range
+                velocities = np.geomspace(vmin, vmax, int(n))
+            if isinstance(model.law, TabulatedLaw):
+                model.law.check_velocities(velocities, "--V")
+            try:
+                result = sweep(model, velocities, options=options, progress=args.verbose)
+            except Interrupted as stop:
+                done = stop.partial.get("result")
+                _kept(done.to_frame() if done else None, args.out,
+                      f"{len(done.results) if done else 0} of {len(velocities)} rows finished and", kept)
+                raise
+            _write(result.to_frame(), args.out)
+            if not result.all_converged:
+                print(f"warning: {result.message}", file=sys.stderr)
+                return 3
+            return 0
+        V, protocol = _protocol(args)
+        t_eval = _t_eval(args)
+        _out_dt(args, 0)
         if isinstance(model.law, TabulatedLaw):
-            model.law.check_velocities(velocities, "--V")
+            model.law.check_velocities(_driving_velocities(V, protocol), "the driving velocity V")
         try:
-            result = sweep(model, velocities, options=options, progress=args.verbose)
+            traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
+                            t_eval=t_eval)
         except Interrupted as stop:
-            done = stop.partial.get("result")
-            _kept(done.to_frame() if done else None, args.out,
-                  f"{len(done.results) if done else 0} of {len(velocities)} rows finished and", kept)
+            part = stop.partial.get("trajectory")
+            if part is not None and part.t.size:
+                part = part.thinned(_out_dt(args, part.t.size))
+                if args.events:
+                    _write(part.events_frame(), args.events, quiet=True)
+                _kept(part.to_frame(), args.out, f"stopped at t = {part.t[-1]:.6g} of {args.t_end:g}; the "
+                                                 f"{part.t.size} rows so far"
+                                                 + (f" (and the events, to {args.events})" if args.events else ""), kept)
             raise
-        _write(result.to_frame(), args.out)
-        if not result.all_converged:
-            print(f"warning: {result.message}", file=sys.stderr)
+        steps = traj.t.size
+        out_dt = _out_dt(args, steps)
+        traj = traj.thinned(out_dt)
+        note = "" if traj.t.size == steps else (f" (of {steps} integrator steps: one row per --out-dt = "
+                                                f"{out_dt:g} between events; --out-dt 0 writes them all)")
+        _write(traj.to_frame(), args.out, note)
+        if args.events:
+            _write(traj.events_frame(), args.events)
+        if not traj.success:
+            print(f"warning: {traj.message}", file=sys.stderr)
             return 3
         return 0
-    V, protocol = _protocol(args)
-    t_eval = _t_eval(args)
-    _out_dt(args, 0)
-    if isinstance(model.law, TabulatedLaw):
-        model.law.check_velocities(_driving_velocities(V, protocol), "the driving velocity V")
-    try:
-        traj = simulate(model, V, protocol=protocol, t_end=args.t_end, options=options,
-                        t_eval=t_eval)
-    except Interrupted as stop:
-        part = stop.partial.get("trajectory")
-        if part is not None and part.t.size:
-            part = part.thinned(_out_dt(args, part.t.size))
-            if args.events:
-                _write(part.events_frame(), args.events, quiet=True)
-            _kept(part.to_frame(), args.out, f"stopped at t = {part.t[-1]:.6g} of {args.t_end:g}; the "
-                                             f"{part.t.size} rows so far"
-                                             + (f" (and the events, to {args.events})" if args.events else ""), kept)
-        raise
-    steps = traj.t.size
-    out_dt = _out_dt(args, steps)
-    traj = traj.thinned(out_dt)
-    note = "" if traj.t.size == steps else (f" (of {steps} integrator steps: one row per --out-dt = "
-                                            f"{out_dt:g} between events; --out-dt 0 writes them all)")
-    _write(traj.to_frame(), args.out, note)
-    if args.events:
-        _write(traj.events_frame(), args.events)
-    if not traj.success:
-        print(f"warning: {traj.message}", file=sys.stderr)
-        return 3
-    return 0
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
