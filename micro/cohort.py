@@ -151,6 +151,7 @@ class _Cohorts:
     #: A cohort's scalars (the kernels' layout), and its cells' layout.
     SCALARS = ("t0", "X0", "s0", "J", "Ej")
     LAYOUT = ("j0", "nn", "off")
+    cycles_run = 0  # cycles run from this state and its copies (for the progress line)
 
     def __init__(self, model: Model, V: float, h: float) -> None:
         self.model, self.V, self.h = model, V, h
@@ -757,7 +758,9 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     sigma_before.)"""
     t_start, sigma_start = st.t, st.sigma
     t_max = 20.0 * st.lam / (st.model.k0 * st.V)
-    with _progress.stage(lambda: f"loading t = {st.t - t_start:.4g}"):
+    st.cycles_run += 1
+    with _progress.stage(lambda: f"cohort V={st.V:.10g} (dt={dt:.3g}, h={st.h:.3g}): cycle {st.cycles_run}, "
+                                 f"loading t = {st.t - t_start:.4g}"):
         return _one_cycle_steps(st, dt, t_start, sigma_start, t_max)
 
 
@@ -1069,163 +1072,162 @@ def cycle_cohorts(model: Model, V: float, *, dt: float = 0.01, h: float | None =
     it, accelerated, passed = 0, False, 0
     slow_multiplier = math.nan
     newton, newton_tries = None, 0  # Newton-Krylov's result, where the frozen map grows
-    with _progress.stage(lambda: f"cohort V={V:.10g} (dt={step:.3g}, h={h:.3g}): cycle {it}"):
-        while it < max_iter:
-            it += 1
-            out = _one_cycle(st, step)
-            if not out["ok"]:
-                applicable, message = False, out["message"]
-                break
-            if st.pool > MAX_CELLS:
-                message = (f"more than {MAX_CELLS} cells alive (blocks that shocks leave unjumped survive for many "
-                           "cycles); use a larger h or method='fp'")
-                break
-            if st.outside > 1e-12:
-                message = f"the delta_R marginal left the nodes ({st.outside:.2g} of the mass)"
-                break
-            if not out["period"] > 1e-9:
-                applicable, message = False, "a shock started with no loading phase (the state is past its fold)"
-                break
-            if _step_off(out["period"], step, dt):
-                # close to V^c the loading phase is short: resolve it with SHORT_PHASE / dt
-                # steps, and start the sequence again at the new step
-                step = _phase_step(out["period"], dt)
+    while it < max_iter:
+        it += 1
+        out = _one_cycle(st, step)
+        if not out["ok"]:
+            applicable, message = False, out["message"]
+            break
+        if st.pool > MAX_CELLS:
+            message = (f"more than {MAX_CELLS} cells alive (blocks that shocks leave unjumped survive for many "
+                       "cycles); use a larger h or method='fp'")
+            break
+        if st.outside > 1e-12:
+            message = f"the delta_R marginal left the nodes ({st.outside:.2g} of the mass)"
+            break
+        if not out["period"] > 1e-9:
+            applicable, message = False, "a shock started with no loading phase (the state is past its fold)"
+            break
+        if _step_off(out["period"], step, dt):
+            # close to V^c the loading phase is short: resolve it with SHORT_PHASE / dt
+            # steps, and start the sequence again at the new step
+            step = _phase_step(out["period"], dt)
+            hist.clear()
+            moves.clear()
+            counts.clear()
+            previous = out["marginal"]
+            passed = 0
+            continue
+        hist.append(tuple(out[name] for name in COLUMNS))
+        moves.append(float(np.abs(out["marginal"] - previous).sum()) if len(hist) > 1 else math.nan)
+        previous = out["marginal"]
+        counts.append(len(out["steps"]))
+        # (INFO: the progress within a row that `micro sweep -v` shows; each cycle is one step of the iteration)
+        log.info("cohort k0=%g V=%g h=%.3g cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f",
+                 model.k0, V, h, it, out["sigma_max"], out["sigma_min"], out["sigma_before"])
+        if len(hist) >= WINDOW:
+            slowest = _relaxation_multiplier(model, out["period"])
+            a = np.array(hist)
+            errors, how, best, rho = _estimate(a, tol, slowest)
+            if not accelerated:
+                # a quantity's steps can pass through zero while the state still moves: its
+                # error is at least what the state's last move leaves (:func:`_state_tail`)
+                tail, _ = _state_tail(a, np.array(moves), np.array(counts), slowest)
+                for i in JUDGED:
+                    if tail > errors[i]:
+                        errors[i], how[i] = tail, "state's move"
+            if accelerated and 0.0 < slow_multiplier < 1.0:
+                # after the acceleration the sequence holds what the map's slowest modes
+                # left: a last step d leaves up to d m / (1 - m) to go (m the slowest
+                # multiplier, of the map at frozen slips)
+                last = np.abs(np.diff(a[-2:], axis=0)[0])
+                errors = np.maximum(errors, last * slow_multiplier / (1.0 - slow_multiplier))
+            error = float(errors[list(JUDGED)].max())
+            # (steps too small to show a ratio, but not small enough for the slowest mode's
+            # tail: a slow sequence as well)
+            slow = any((how[i] in ("Aitken", "slow") and rho[i] > SLOW_CAVEAT)
+                       or (how[i] in ("last steps", "noise", "state's move") and errors[i] > tol) for i in JUDGED)
+        elif eager and not accelerated:
+            slow = True  # (the start's own run was accelerated: so is this one, at once)
+        else:
+            continue
+        # (only a short loading phase makes the blocks' relaxation slow from cycle to
+        # cycle: the slowest multiplier is about exp(-0.19 T); from 0.7 V^c down a ratio
+        # above 0.9 is noise, and the acceleration there cost more than it saved)
+        if not accelerated and slow and out["period"] < SHORT_PHASE and out["unjumped"] <= ANDERSON_UNJUMPED:
+            # a state after all but total shocks contracting slowly (close to V^c): solve
+            # the fixed point, then verify it by the plain cycles again (with at least half the
+            # cycles left: below the map's roughness, about 1e-6 of the mass at tol = 1e-6,
+            # Anderson's residual creeps down without stalling and used to take them all)
+            accelerated = True
+            fast, used, slow_multiplier, residual = _anderson(model, V, h, step, dt, st, st.period_ref,
+                                                              ANDERSON_TOL * tol, max((int(max_iter) - it) // 2, 1))
+            it += used
+            if slow_multiplier >= 1.0:
+                # the frozen map grows along some mode, so neither Anderson's iteration nor the
+                # bound m / (1 - m) holds: Newton-Krylov on the whole cycle map, whose error is
+                # its last step, with half the cycles left (from far off, as in a coarse run's
+                # first cycles, its steps are halved and the budget can run out: the plain
+                # cycles then go on from Anderson's state, with a second try below).  Where this
+                # run continues a coarse fixed point certified to tol and Anderson did not meet
+                # its tolerance, it starts from the state Anderson started from: at k0 = 1e-3,
+                # V = 70 it certified from there in 44 cycles, and from Anderson's stalled state
+                # not in 190 (docs/validation/micro_cohort.md section 5)
+                origin = st if from_coarse and not residual <= ANDERSON_TOL * tol else fast
+                newton = _newton(step, dt, origin if origin is not None else st, tol, (int(max_iter) - it) // 2)
+                newton_tries += 1
+                it += newton.evals
+                if newton.certified:
+                    fast = newton.state
+            if fast is not None:
+                st = fast
                 hist.clear()
                 moves.clear()
                 counts.clear()
-                previous = out["marginal"]
+                previous = st.node_masses()
                 passed = 0
                 continue
-            hist.append(tuple(out[name] for name in COLUMNS))
-            moves.append(float(np.abs(out["marginal"] - previous).sum()) if len(hist) > 1 else math.nan)
-            previous = out["marginal"]
-            counts.append(len(out["steps"]))
-            # (INFO: the progress within a row that `micro sweep -v` shows; each cycle is one step of the iteration)
-            log.info("cohort k0=%g V=%g h=%.3g cycle %d: sigma_max %.10f sigma_min %.10f sigma_before %.10f",
-                     model.k0, V, h, it, out["sigma_max"], out["sigma_min"], out["sigma_before"])
-            if len(hist) >= WINDOW:
-                slowest = _relaxation_multiplier(model, out["period"])
-                a = np.array(hist)
-                errors, how, best, rho = _estimate(a, tol, slowest)
-                if not accelerated:
-                    # a quantity's steps can pass through zero while the state still moves: its
-                    # error is at least what the state's last move leaves (:func:`_state_tail`)
-                    tail, _ = _state_tail(a, np.array(moves), np.array(counts), slowest)
-                    for i in JUDGED:
-                        if tail > errors[i]:
-                            errors[i], how[i] = tail, "state's move"
-                if accelerated and 0.0 < slow_multiplier < 1.0:
-                    # after the acceleration the sequence holds what the map's slowest modes
-                    # left: a last step d leaves up to d m / (1 - m) to go (m the slowest
-                    # multiplier, of the map at frozen slips)
-                    last = np.abs(np.diff(a[-2:], axis=0)[0])
-                    errors = np.maximum(errors, last * slow_multiplier / (1.0 - slow_multiplier))
-                error = float(errors[list(JUDGED)].max())
-                # (steps too small to show a ratio, but not small enough for the slowest mode's
-                # tail: a slow sequence as well)
-                slow = any((how[i] in ("Aitken", "slow") and rho[i] > SLOW_CAVEAT)
-                           or (how[i] in ("last steps", "noise", "state's move") and errors[i] > tol) for i in JUDGED)
-            elif eager and not accelerated:
-                slow = True  # (the start's own run was accelerated: so is this one, at once)
-            else:
-                continue
-            # (only a short loading phase makes the blocks' relaxation slow from cycle to
-            # cycle: the slowest multiplier is about exp(-0.19 T); from 0.7 V^c down a ratio
-            # above 0.9 is noise, and the acceleration there cost more than it saved)
-            if not accelerated and slow and out["period"] < SHORT_PHASE and out["unjumped"] <= ANDERSON_UNJUMPED:
-                # a state after all but total shocks contracting slowly (close to V^c): solve
-                # the fixed point, then verify it by the plain cycles again (with at least half the
-                # cycles left: below the map's roughness, about 1e-6 of the mass at tol = 1e-6,
-                # Anderson's residual creeps down without stalling and used to take them all)
-                accelerated = True
-                fast, used, slow_multiplier, residual = _anderson(model, V, h, step, dt, st, st.period_ref,
-                                                                  ANDERSON_TOL * tol, max((int(max_iter) - it) // 2, 1))
-                it += used
-                if slow_multiplier >= 1.0:
-                    # the frozen map grows along some mode, so neither Anderson's iteration nor the
-                    # bound m / (1 - m) holds: Newton-Krylov on the whole cycle map, whose error is
-                    # its last step, with half the cycles left (from far off, as in a coarse run's
-                    # first cycles, its steps are halved and the budget can run out: the plain
-                    # cycles then go on from Anderson's state, with a second try below).  Where this
-                    # run continues a coarse fixed point certified to tol and Anderson did not meet
-                    # its tolerance, it starts from the state Anderson started from: at k0 = 1e-3,
-                    # V = 70 it certified from there in 44 cycles, and from Anderson's stalled state
-                    # not in 190 (docs/validation/micro_cohort.md section 5)
-                    origin = st if from_coarse and not residual <= ANDERSON_TOL * tol else fast
-                    newton = _newton(step, dt, origin if origin is not None else st, tol, (int(max_iter) - it) // 2)
-                    newton_tries += 1
-                    it += newton.evals
-                    if newton.certified:
-                        fast = newton.state
-                if fast is not None:
-                    st = fast
+        if len(hist) < WINDOW:
+            continue
+        passed = passed + 1 if error <= tol else 0
+        if passed >= 2 and accelerated and slow_multiplier >= 1.0:
+            # the frozen map grows along some mode (Anderson's bound does not hold)
+            if newton is not None and newton.certified:
+                # the plain cycles from Newton's fixed point: the error is the larger of Newton's
+                # (its last step), the cycles' own estimate, and how far they moved from it
+                drift = np.abs(np.array(hist)[-WINDOW:, list(JUDGED)]
+                               - np.array([newton.row[COLUMNS[i]] for i in JUDGED])).max(axis=0)
+                error = float(max(np.max(errors[list(JUDGED)]), newton.error, drift.max()))
+                converged, value = True, best
+                message = (f"limit cycle by cohorts, by Newton-Krylov on the cycle map (the frozen map's slowest "
+                           f"multiplier is {slow_multiplier:.4f} >= 1, so Anderson's bound does not hold): residual "
+                           f"{newton.residual:.1e} of the mass in {newton.evals} cycles, its last step moved the "
+                           f"stresses by {newton.error:.1e}; cycles {it - WINDOW + 1}-{it} (of {it}) stay within "
+                           f"{drift.max():.1e} of it; error {error:.1e}")
+                break
+            if newton_tries < 2:
+                # the plain cycles' test is not enough where the frozen map grows: a second try of
+                # Newton-Krylov from where they passed it (closer to the fixed point), then the
+                # plain cycles again (leaving them at least 2 WINDOW of the budget)
+                newton = _newton(step, dt, st, tol, max(int(max_iter) - it - 2 * WINDOW, 0))
+                newton_tries += 1
+                it += newton.evals
+                if newton.certified:
+                    st = newton.state
                     hist.clear()
                     moves.clear()
                     counts.clear()
                     previous = st.node_masses()
                     passed = 0
                     continue
-            if len(hist) < WINDOW:
-                continue
-            passed = passed + 1 if error <= tol else 0
-            if passed >= 2 and accelerated and slow_multiplier >= 1.0:
-                # the frozen map grows along some mode (Anderson's bound does not hold)
-                if newton is not None and newton.certified:
-                    # the plain cycles from Newton's fixed point: the error is the larger of Newton's
-                    # (its last step), the cycles' own estimate, and how far they moved from it
-                    drift = np.abs(np.array(hist)[-WINDOW:, list(JUDGED)]
-                                   - np.array([newton.row[COLUMNS[i]] for i in JUDGED])).max(axis=0)
-                    error = float(max(np.max(errors[list(JUDGED)]), newton.error, drift.max()))
-                    converged, value = True, best
-                    message = (f"limit cycle by cohorts, by Newton-Krylov on the cycle map (the frozen map's slowest "
-                               f"multiplier is {slow_multiplier:.4f} >= 1, so Anderson's bound does not hold): residual "
-                               f"{newton.residual:.1e} of the mass in {newton.evals} cycles, its last step moved the "
-                               f"stresses by {newton.error:.1e}; cycles {it - WINDOW + 1}-{it} (of {it}) stay within "
-                               f"{drift.max():.1e} of it; error {error:.1e}")
-                    break
-                if newton_tries < 2:
-                    # the plain cycles' test is not enough where the frozen map grows: a second try of
-                    # Newton-Krylov from where they passed it (closer to the fixed point), then the
-                    # plain cycles again (leaving them at least 2 WINDOW of the budget)
-                    newton = _newton(step, dt, st, tol, max(int(max_iter) - it - 2 * WINDOW, 0))
-                    newton_tries += 1
-                    it += newton.evals
-                    if newton.certified:
-                        st = newton.state
-                        hist.clear()
-                        moves.clear()
-                        counts.clear()
-                        previous = st.node_masses()
-                        passed = 0
-                        continue
-                # the frozen map grows along some mode: it gives no bound on what a slower mode of
-                # the full map leaves, and the plain cycles' test alone is not enough (at k0 = 0.01,
-                # 0.9 V^c, h = kappa zbar / 40 it passed 3e-5 short of the fixed point that 450
-                # cycles reach, against an estimate of 1.9e-6; docs/validation/micro_cohort.md
-                # section 5): the stopping test is met, but the fixed point's error is not known
-                converged, value, error = True, best, math.nan
-                message = (f"limit cycle by cohorts, its error not known: the cycles pass the stopping test after "
-                           f"Anderson's iteration (its last step {residual:.1e} of the mass), but the frozen map's "
-                           f"slowest multiplier is {slow_multiplier:.4f} >= 1, so nothing bounds a slower mode of "
-                           f"the cycle map (no certified fixed point; such runs were 3e-5 to 4e-4 off where checked), and "
-                           f"Newton-Krylov on the whole map did not certify one "
-                           f"({newton.message if newton is not None else 'not run'})")
-                break
-            if passed >= 2:  # (two cycles in a row: one estimate may pass by chance)
-                converged, value = True, best
-                worst = max(JUDGED, key=lambda i: errors[i])
-                message = (f"limit cycle by cohorts: cycles {it - WINDOW + 1}-{it} (of {it}) give sigma_max to "
-                           f"{errors[0]:.1e} ({how[0]}), sigma_min to {errors[1]:.1e} ({how[1]}); the least certain, "
-                           f"{COLUMNS[worst]}, to {errors[worst]:.1e}")
-                extrapolated = [rho[i] for i in JUDGED if how[i] == "Aitken"]
-                ratio = max(extrapolated, default=0.0)
-                if accelerated and 0.0 < slow_multiplier < 1.0:
-                    message += (f"; after Anderson's preconditioned iteration, each error at least the last step "
-                                f"times m / (1 - m), m = {slow_multiplier:.4f} the map's slowest multiplier")
-                elif extrapolated and ratio > SLOW_CAVEAT:
-                    message += (f"; the cycles contract by {ratio:.2f} a cycle, five cycles can hide a slower mode "
-                                "(docs/reference/micro_cohort.md, section 4)")
-                break
+            # the frozen map grows along some mode: it gives no bound on what a slower mode of
+            # the full map leaves, and the plain cycles' test alone is not enough (at k0 = 0.01,
+            # 0.9 V^c, h = kappa zbar / 40 it passed 3e-5 short of the fixed point that 450
+            # cycles reach, against an estimate of 1.9e-6; docs/validation/micro_cohort.md
+            # section 5): the stopping test is met, but the fixed point's error is not known
+            converged, value, error = True, best, math.nan
+            message = (f"limit cycle by cohorts, its error not known: the cycles pass the stopping test after "
+                       f"Anderson's iteration (its last step {residual:.1e} of the mass), but the frozen map's "
+                       f"slowest multiplier is {slow_multiplier:.4f} >= 1, so nothing bounds a slower mode of "
+                       f"the cycle map (no certified fixed point; such runs were 3e-5 to 4e-4 off where checked), and "
+                       f"Newton-Krylov on the whole map did not certify one "
+                       f"({newton.message if newton is not None else 'not run'})")
+            break
+        if passed >= 2:  # (two cycles in a row: one estimate may pass by chance)
+            converged, value = True, best
+            worst = max(JUDGED, key=lambda i: errors[i])
+            message = (f"limit cycle by cohorts: cycles {it - WINDOW + 1}-{it} (of {it}) give sigma_max to "
+                       f"{errors[0]:.1e} ({how[0]}), sigma_min to {errors[1]:.1e} ({how[1]}); the least certain, "
+                       f"{COLUMNS[worst]}, to {errors[worst]:.1e}")
+            extrapolated = [rho[i] for i in JUDGED if how[i] == "Aitken"]
+            ratio = max(extrapolated, default=0.0)
+            if accelerated and 0.0 < slow_multiplier < 1.0:
+                message += (f"; after Anderson's preconditioned iteration, each error at least the last step "
+                            f"times m / (1 - m), m = {slow_multiplier:.4f} the map's slowest multiplier")
+            elif extrapolated and ratio > SLOW_CAVEAT:
+                message += (f"; the cycles contract by {ratio:.2f} a cycle, five cycles can hide a slower mode "
+                            "(docs/reference/micro_cohort.md, section 4)")
+            break
     if not converged and not message:
         message = f"no fixed point to {tol:g} in {max_iter} cycles (error estimate {error:.2g})"
     values = np.array(hist).reshape(-1, len(COLUMNS))
