@@ -286,67 +286,67 @@ def stationary_fp(
     t_begin = grid.t
     regime, converged, message = "unknown", False, ""
     out: dict = {}
-    with _progress.stage(lambda: f"Fokker-Planck V={V:g} eps={settings.eps:g}: t = {grid.t - t_begin:.4g} "
-                                f"of at most {t_max:.4g}"):
-        while True:
-            t_now = grid.t
-            # (the last chunk may overshoot t_max; stopping exactly at t_max shortened the
-            # runs of the phase diagram's coarse-bin bisection and flipped their labels,
-            # see docs/validation/micro_results.md)
+    while True:
+        t_now = grid.t
+        # (the last chunk may overshoot t_max; stopping exactly at t_max shortened the
+        # runs of the phase diagram's coarse-bin bisection and flipped their labels,
+        # see docs/validation/micro_results.md)
+        with _progress.stage(lambda: f"Fokker-Planck V={V:g} eps={settings.eps:g}: t = {grid.t - t_begin:.4g} "
+                                     f"of at most {t_max:.4g}"):
             r, s, code = grid.advance(V, t_now + chunk, record_dsigma=resolution, record_dt=span / 20.0)
-            rec = rec.extend(Records.from_array(r))
-            if len(s):
-                shock_rows.append(s)
-            t_now = grid.t
-            elapsed = t_now - t_begin
-            # --- a converged limit cycle?
-            cycles = find_cycles(rec, hysteresis)
-            if len(cycles) >= n and cycle_converged(cycles, convergence.rtol, convergence.atol + jitter, n):
-                last = cycles.iloc[-n:]
-                regime, converged = "stick-slip", True
-                message = f"limit cycle converged over {n} cycles"
-                drop = float((last.sigma_max - last.sigma_min).mean())
-                per_cycle = _shocks_per_cycle(_shock_times(shock_rows), last)
-                if _grid_sized(drop, per_cycle, _grid_limit(model, settings.eps)):
-                    message += _grid_note(drop, jitter)
-                    if warn:
-                        log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
-                out = dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
-                           sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
-                           sigma_stderr=float(last.sigma_mean.std(ddof=1) / math.sqrt(n)), shocks_per_cycle=per_cycle)
+        rec = rec.extend(Records.from_array(r))
+        if len(s):
+            shock_rows.append(s)
+        t_now = grid.t
+        elapsed = t_now - t_begin
+        # --- a converged limit cycle?
+        cycles = find_cycles(rec, hysteresis)
+        if len(cycles) >= n and cycle_converged(cycles, convergence.rtol, convergence.atol + jitter, n):
+            last = cycles.iloc[-n:]
+            regime, converged = "stick-slip", True
+            message = f"limit cycle converged over {n} cycles"
+            drop = float((last.sigma_max - last.sigma_min).mean())
+            per_cycle = _shocks_per_cycle(_shock_times(shock_rows), last)
+            if _grid_sized(drop, per_cycle, _grid_limit(model, settings.eps)):
+                message += _grid_note(drop, jitter)
+                if warn:
+                    log.warning("micro.stationary(k0=%g, V=%g): %s", model.k0, V, message)
+            out = dict(sigma_max=float(last.sigma_max.mean()), sigma_min=float(last.sigma_min.mean()),
+                       sigma_mean=float(last.sigma_mean.mean()), period=float(last.period.mean()),
+                       sigma_stderr=float(last.sigma_mean.std(ddof=1) / math.sqrt(n)), shocks_per_cycle=per_cycle)
+            break
+        # --- a steady state?  No cycle in the last n spans, and span means that agree
+        # within the tolerance plus their own statistical error (the jitter).
+        if elapsed >= (n + 1) * span:
+            t_from = t_now - n * span
+            recent = cycles[cycles.t_end > t_from] if len(cycles) else cycles
+            means, errors = _span_means(rec, t_from, span, n)
+            # rtol of the velocity weakening, floored at rtol of the jitter (where the
+            # weakening vanishes, e.g. k2 = 0, differences below the grid's resolution
+            # carry no information)
+            tol = convergence.rtol * (abs(float(np.mean(means)) - s_inf) + jitter) + convergence.atol
+            agree = all(abs(means[i] - means[k]) <= tol + 2.0 * math.hypot(errors[i], errors[k])
+                        for i in range(n) for k in range(i + 1, n))
+            # a loading phase (blocks stuck, the stress rising at k0 V) can look flat when
+            # k0 V span is below the tolerance: require the blocks to keep up with the drive
+            loading = abs(means[-1] - means[0]) > 0.25 * model.k0 * V * (n - 1) * span
+            if len(recent) == 0 and np.all(np.isfinite(means)) and agree and not loading:
+                regime, converged = "steady", True
+                message = f"steady: {n} span means agree within {tol:.3g} plus their statistical error"
+                sigma = float(np.mean(means))
+                out = dict(sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma, period=math.nan,
+                           sigma_stderr=float(math.sqrt(np.sum(np.square(errors))) / n))
                 break
-            # --- a steady state?  No cycle in the last n spans, and span means that agree
-            # within the tolerance plus their own statistical error (the jitter).
-            if elapsed >= (n + 1) * span:
-                t_from = t_now - n * span
-                recent = cycles[cycles.t_end > t_from] if len(cycles) else cycles
-                means, errors = _span_means(rec, t_from, span, n)
-                # rtol of the velocity weakening, floored at rtol of the jitter (where the
-                # weakening vanishes, e.g. k2 = 0, differences below the grid's resolution
-                # carry no information)
-                tol = convergence.rtol * (abs(float(np.mean(means)) - s_inf) + jitter) + convergence.atol
-                agree = all(abs(means[i] - means[k]) <= tol + 2.0 * math.hypot(errors[i], errors[k])
-                            for i in range(n) for k in range(i + 1, n))
-                # a loading phase (blocks stuck, the stress rising at k0 V) can look flat when
-                # k0 V span is below the tolerance: require the blocks to keep up with the drive
-                loading = abs(means[-1] - means[0]) > 0.25 * model.k0 * V * (n - 1) * span
-                if len(recent) == 0 and np.all(np.isfinite(means)) and agree and not loading:
-                    regime, converged = "steady", True
-                    message = f"steady: {n} span means agree within {tol:.3g} plus their statistical error"
-                    sigma = float(np.mean(means))
-                    out = dict(sigma_max=sigma, sigma_min=sigma, sigma_mean=sigma, period=math.nan,
-                               sigma_stderr=float(math.sqrt(np.sum(np.square(errors))) / n))
-                    break
-            if elapsed >= t_max or code != K.DONE:
-                regime, message, out = _unconverged(rec, cycles, hysteresis, t_now, span, elapsed, t_max, code,
-                                                    load_rate=model.k0 * V, shock_times=_shock_times(shock_rows),
-                                                    grid_limit=_grid_limit(model, settings.eps))
-                break
-            # lengthen the chunks while no cycle has shown up (slow stick-slip)
-            if len(cycles) == 0:
-                chunk = min(2.0 * chunk, max(span, 0.25 * t_max))
-            else:
-                chunk = max(span, 2.0 * float(cycles.period.iloc[-1]))
+        if elapsed >= t_max or code != K.DONE:
+            regime, message, out = _unconverged(rec, cycles, hysteresis, t_now, span, elapsed, t_max, code,
+                                                load_rate=model.k0 * V, shock_times=_shock_times(shock_rows),
+                                                grid_limit=_grid_limit(model, settings.eps))
+            break
+        # lengthen the chunks while no cycle has shown up (slow stick-slip)
+        if len(cycles) == 0:
+            chunk = min(2.0 * chunk, max(span, 0.25 * t_max))
+        else:
+            chunk = max(span, 2.0 * float(cycles.period.iloc[-1]))
     shocks = np.concatenate(shock_rows) if shock_rows else np.zeros((0, 4))
     result = Stationary(
         model=model, V=V, eps=settings.eps, regime=regime, converged=converged, message=message,
@@ -579,48 +579,48 @@ def critical_velocity_fp(
     def run(V: float, conv: Convergence, num: Numerics, chain: dict) -> tuple[Stationary, float]:
         """A run at V, from the chain's steady state if it is faster than V."""
         started_from = chain["V"] if V < chain["V"] and chain["grid"] is not None else math.nan
-        res = stationary_fp(model, V, numerics=num, convergence=conv, keep_grid=True, keep_records=refine,
-                         initial=chain["grid"] if math.isfinite(started_from) else "auto", warn=False)
+        with _progress.stage(f"bisection k0={model.k0:g}: run {len(evaluations) + 1} at V = {V:.6g}"):
+            res = stationary_fp(model, V, numerics=num, convergence=conv, keep_grid=True, keep_records=refine,
+                                initial=chain["grid"] if math.isfinite(started_from) else "auto", warn=False)
         return res, started_from
 
     def regime(V: float) -> str:
-        with _progress.stage(f"bisection k0={model.k0:g}: run {len(evaluations) + 1} at V = {V:.6g}"):
-            conv = convergence
-            if conv.t_max is None:
-                # Only the regime is needed: near V^c the finite-eps dynamics is a noisy
-                # oscillation that never meets the stopping test, and its trend is clear
-                # well before the default t_max.
-                tau_u, _, tau_load = _time_scales(model, V)
-                t_max = max(100.0 * tau_u if math.isfinite(tau_u) else 0.0, 30.0 * tau_load)
-                conv = Convergence(rtol=conv.rtol, atol=conv.atol, n=conv.n, t_max=t_max)
-            res, started_from = run(V, conv, numerics, slowest_steady)
-            amplitude, fine_amplitude, fine_wall = math.nan, math.nan, math.nan
-            if not refine:
-                label = _bisection_label(res)
-            else:
-                label = res.regime
-                amplitude = _cycle_amplitude(res)
-                if res.regime == "stick-slip" and amplitude < GRID_CYCLE_EPS * eps:
-                    # too small to tell from the grid's own oscillation: does it survive at eps / 2?
-                    fine_wall = 0.0
-                    if fine_steady["grid"] is None and math.isfinite(slowest_steady["V"]):
-                        base, _ = run(slowest_steady["V"], conv, fine_numerics, fine_steady)
-                        fine_steady.update(V=slowest_steady["V"], grid=base.grid)
-                        fine_wall += base.wall_time
-                    fine, _ = run(V, conv, fine_numerics, fine_steady)
-                    fine_wall += fine.wall_time
-                    fine_amplitude = _cycle_amplitude(fine)
-                    if fine_amplitude < REFINE_RATIO * amplitude:
-                        label = "steady"
-                        if V < fine_steady["V"]:
-                            fine_steady.update(V=V, grid=fine.grid)
-            if label == "steady" and V < slowest_steady["V"]:
-                slowest_steady.update(V=V, grid=res.grid)
-            evaluations.append(dict(res.to_dict(), label=label, started_from=started_from, amplitude=amplitude,
-                                    amplitude_fine=fine_amplitude, wall_time_fine=fine_wall))
-            log.info("bisection k0=%g V=%.6g -> %s (%s; amplitude %.3g, at eps/2 %.3g)", model.k0, V, label,
-                     res.message, amplitude, fine_amplitude)
-            return label
+        conv = convergence
+        if conv.t_max is None:
+            # Only the regime is needed: near V^c the finite-eps dynamics is a noisy
+            # oscillation that never meets the stopping test, and its trend is clear
+            # well before the default t_max.
+            tau_u, _, tau_load = _time_scales(model, V)
+            t_max = max(100.0 * tau_u if math.isfinite(tau_u) else 0.0, 30.0 * tau_load)
+            conv = Convergence(rtol=conv.rtol, atol=conv.atol, n=conv.n, t_max=t_max)
+        res, started_from = run(V, conv, numerics, slowest_steady)
+        amplitude, fine_amplitude, fine_wall = math.nan, math.nan, math.nan
+        if not refine:
+            label = _bisection_label(res)
+        else:
+            label = res.regime
+            amplitude = _cycle_amplitude(res)
+            if res.regime == "stick-slip" and amplitude < GRID_CYCLE_EPS * eps:
+                # too small to tell from the grid's own oscillation: does it survive at eps / 2?
+                fine_wall = 0.0
+                if fine_steady["grid"] is None and math.isfinite(slowest_steady["V"]):
+                    base, _ = run(slowest_steady["V"], conv, fine_numerics, fine_steady)
+                    fine_steady.update(V=slowest_steady["V"], grid=base.grid)
+                    fine_wall += base.wall_time
+                fine, _ = run(V, conv, fine_numerics, fine_steady)
+                fine_wall += fine.wall_time
+                fine_amplitude = _cycle_amplitude(fine)
+                if fine_amplitude < REFINE_RATIO * amplitude:
+                    label = "steady"
+                    if V < fine_steady["V"]:
+                        fine_steady.update(V=V, grid=fine.grid)
+        if label == "steady" and V < slowest_steady["V"]:
+            slowest_steady.update(V=V, grid=res.grid)
+        evaluations.append(dict(res.to_dict(), label=label, started_from=started_from, amplitude=amplitude,
+                                amplitude_fine=fine_amplitude, wall_time_fine=fine_wall))
+        log.info("bisection k0=%g V=%.6g -> %s (%s; amplitude %.3g, at eps/2 %.3g)", model.k0, V, label,
+                 res.message, amplitude, fine_amplitude)
+        return label
 
     # Bracket by expanding geometrically from V_guess: evaluations far from V^c are
     # the expensive ones (cost grows like V at large V and like 1/V at small V).
