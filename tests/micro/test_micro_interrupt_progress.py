@@ -58,7 +58,8 @@ def test_run_stops_within_seconds_and_keeps_the_records_so_far(tmp_path):
     assert m, line
     rows = pd.read_csv(tmp_path / "r.csv")
     assert len(rows) == int(m.group(2)) > 0
-    assert np.all(np.diff(rows.t) > 0) and 0.0 < rows.t.iloc[-1] < 20.0
+    # (non-decreasing: a shock is recorded on both sides, at one time)
+    assert np.all(np.diff(rows.t) >= 0) and 0.0 < rows.t.iloc[-1] < 20.0
     assert abs(rows.t.iloc[-1] - float(m.group(1))) <= 1e-5 * rows.t.iloc[-1]
 
 
