@@ -28,7 +28,7 @@ from functools import lru_cache
 import numpy as np
 import pandas as pd
 
-from . import fp
+from . import _progress, fp
 from .analytic import sigma_fast_limit
 from .cohort import GRADED_MAX, cycle_cohorts, not_applicable as cohort_not_applicable
 from .methods import COHORT_STEPS_MAX, FP, Auto, Cohort, Convergence, Method, Renewal, check_velocity, resolve
@@ -313,18 +313,26 @@ def sweep(
             check_cohort_work(model, V, cohort)
     rows: list[dict] = []
     seed_grid = None
-    for V in velocities:
-        if isinstance(opts, FP):
-            res = stationary(model, V, method="fp", numerics=numerics, convergence=convergence,
-                             initial=seed_grid if (continuation and seed_grid is not None) else "auto",
-                             keep_grid=continuation)
-            seed_grid, res.grid = res.grid, None
-        else:
-            res = stationary(model, V, method=opts, numerics=numerics, convergence=convergence)
-        rows.append(res.to_dict())
+    for i, V in enumerate(velocities):
+        with _progress.stage(f"row {i + 1} of {len(velocities)}, V={V:.10g}"):
+            row, seed_grid = _sweep_row(model, V, opts, numerics, convergence, continuation, seed_grid)
+        rows.append(row)
         if on_row is not None:
             on_row(pd.DataFrame(rows))
     return pd.DataFrame(rows)
+
+
+def _sweep_row(model, V, opts, numerics, convergence, continuation, seed_grid) -> tuple[dict, object]:
+    """One row of :func:`sweep`, and the grid the next row starts from (a continued
+    Fokker-Planck row's final density; else None)."""
+    if isinstance(opts, FP):
+        res = stationary(model, V, method="fp", numerics=numerics, convergence=convergence,
+                         initial=seed_grid if (continuation and seed_grid is not None) else "auto",
+                         keep_grid=continuation)
+        grid, res.grid = res.grid, None
+        return res.to_dict(), grid
+    res = stationary(model, V, method=opts, numerics=numerics, convergence=convergence)
+    return res.to_dict(), None
 
 
 # ------------------------------------------------------------------------------ critical velocity

@@ -23,6 +23,7 @@ from pathlib import Path
 import pandas as pd
 
 from . import _outputs
+from ._progress import Interrupted, reporting
 from .api import critical_velocity, simulate, sweep
 from .methods import FP, RETIRED, Auto, Cohort, Convergence, default_eps
 from .params import Deterministic, Exponential, Model
@@ -298,11 +299,24 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    kept: list[str] = []  # what a Ctrl-C leaves on disk, as the commands write it
     try:
-        return _run(args)
+        with reporting(_progress_line(f"micro {args.command}"), first=0.2, interval=1.0, longest=10.0):
+            return _run(args, kept)
     except (ValueError, argparse.ArgumentTypeError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"interrupted: {kept[-1] if kept else 'nothing was finished, nothing written'}", file=sys.stderr)
+        return 130
+
+
+def _progress_line(prefix: str):
+    """The command line's progress callback: one line on stderr per report (every second
+    at first, then every 2, 4, ... up to 10 seconds)."""
+    def show(text: str, elapsed: float) -> None:
+        print(f"{prefix}: {text} [{elapsed:.0f} s]", file=sys.stderr, flush=True)
+    return show
 
 
 def _options(args, models: list[Model]):
@@ -382,7 +396,9 @@ def _check_critical_range(args) -> None:
         raise ValueError(f"--rel-tol must be in (0, 1), got {args.rel_tol!r}")
 
 
-def _run(args) -> int:
+def _run(args, kept: list[str]) -> int:
+    """Run the command; ``kept`` gets a line saying what is on disk after each write (the
+    message of a Ctrl-C)."""
     start = time.perf_counter()
     # everything is checked before anything is computed
     out = _check_out(args.out)
@@ -408,6 +424,7 @@ def _run(args) -> int:
             # nothing (standard output, a device or a FIFO take the rows once, at the end)
             if out.replaceable:
                 _write_csv(frame, out)
+                kept.append(f"{len(frame)} of {len(velocities)} rows finished and written to {out}")
             last = frame.iloc[-1]
             print(f"{_progress(len(frame), len(velocities), time.perf_counter() - start)} V={last.V:g}: "
                   f"{last.regime} ({last.method}), sigma_max={last.sigma_max:.6f}, sigma_min={last.sigma_min:.6f}"
@@ -433,9 +450,13 @@ def _run(args) -> int:
             row = crit.to_dict()
             row["status"], row["message"] = _as_flags(row["status"]), _as_flags(row["message"])
             rows.append(row)
-            _write_csv(pd.DataFrame(rows), out)   # every finished row is kept, whatever comes next
+            if out.replaceable:  # (every finished row is kept: a later one may take minutes, or fail)
+                _write_csv(pd.DataFrame(rows), out)
+                kept.append(f"{len(rows)} of {len(models)} rows finished and written to {out}")
             print(f"{_progress(i + 1, len(models), time.perf_counter() - start)} k0={model.k0:g}: "
                   f"Vc={crit.Vc:.6g} ({row['status']})", file=sys.stderr)
+        if not out.replaceable:
+            _write_csv(pd.DataFrame(rows), out)
         print(f"wrote {len(rows)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0
     # run
@@ -456,7 +477,15 @@ def _run(args) -> int:
             _bounded(value, f"--shs {name}", 0.0, T_MAX, open_low=name != "HOLD")
         _bounded(slide + hold + resume, "--shs SLIDE + HOLD + RESUME", 0.0, T_MAX, open_low=True)
         drive = Drive.slide_hold_slide(v, slide, hold, resume)
-    run = simulate(models[0], drive, numerics=numerics, progress=True)
+    try:
+        run = simulate(models[0], drive, numerics=numerics)
+    except Interrupted as stop:
+        partial = stop.partial.get("run")
+        if partial is not None and len(partial.records):
+            _write_csv(partial.records, out)
+            kept.append(f"stopped at t = {partial.records.t.iloc[-1]:.6g} of {drive.duration:g}; "
+                        f"the {len(partial.records)} rows so far written to {out}")
+        raise
     _write_csv(run.records, out)
     eps = numerics.eps if numerics.eps is not None else default_eps(models[0])
     print(f"wrote {len(run.records)} rows to {out} (eps={eps:g}) in {time.perf_counter() - start:.1f} s",

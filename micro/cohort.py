@@ -49,6 +49,7 @@ import scipy.linalg
 
 from . import _cohort_kernels as CK
 from . import _cohort_newton
+from . import _progress
 from ._threads import blas_single_threaded
 from .params import KIND_EXPONENTIAL, Model
 from .results import CycleFixedPoint
@@ -150,6 +151,7 @@ class _Cohorts:
     #: A cohort's scalars (the kernels' layout), and its cells' layout.
     SCALARS = ("t0", "X0", "s0", "J", "Ej")
     LAYOUT = ("j0", "nn", "off")
+    cycles_run = 0  # cycles run from this state and its copies (for the progress line)
 
     def __init__(self, model: Model, V: float, h: float) -> None:
         self.model, self.V, self.h = model, V, h
@@ -754,12 +756,21 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
     mesh instead, halving the rest of the step, makes the map discontinuous in where the
     start falls, and at k0 = 0.3, 0.2 V^c its cycles alternate by 5.6e-5 in
     sigma_before.)"""
-    t_start, sigma_start, integral = st.t, st.sigma, 0.0
+    t_start, sigma_start = st.t, st.sigma
+    t_max = 20.0 * st.lam / (st.model.k0 * st.V)
+    st.cycles_run += 1
+    with _progress.stage(lambda: f"cohort V={st.V:.10g} (dt={dt:.3g}, h={st.h:.3g}): cycle {st.cycles_run}, "
+                                 f"loading t = {st.t - t_start:.4g}"):
+        return _one_cycle_steps(st, dt, t_start, sigma_start, t_max)
+
+
+def _one_cycle_steps(st: _Cohorts, dt: float, t_start: float, sigma_start: float, t_max: float) -> dict:
+    """The steps of :func:`_one_cycle` (within its progress stage)."""
+    integral = 0.0
     peak = trough = st.sigma
     snapshot = None
     steps = []  # (length, slip) of every step the cycle committed, the shock's last
     replay = st.peak_excess > PEAK_FLOOR
-    t_max = 20.0 * st.lam / (st.model.k0 * st.V)
     gamma = st.model.gamma
 
     def advance(x, length, phi, Edt):
@@ -771,6 +782,7 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
         peak, trough = max(peak, st.sigma), min(trough, st.sigma)
 
     while True:
+        _progress.beat()
         if st.t - t_start > t_max:
             return dict(ok=False, message=f"no shock within t = {t_max:.3g} of the last one")
         step = _step_length(st.t - t_start, st.period_ref, dt, gamma)

@@ -8,11 +8,14 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _fp_kernels as K
+from . import _progress
+from ._progress import Interrupted
 from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
 
 __all__ = ["Grid", "GridSettings"]
@@ -21,6 +24,16 @@ log = logging.getLogger(__name__)
 
 #: Mass of the jump-length distribution left beyond the grid's last column.
 TAIL_MASS = 1e-12
+#: Kernel steps of the first call of :meth:`Grid.advance`, and the bounds of the later
+#: ones (tuned to about ``micro._progress.CHUNK_SECONDS`` of wall time each).
+CHUNK_FIRST = 16
+CHUNK_MIN = 1
+CHUNK_MAX = 50_000_000
+
+
+def _joined(parts: list[np.ndarray], width: int) -> np.ndarray:
+    """The rows of ``parts`` in one array (``(0, width)`` if none)."""
+    return np.concatenate(parts) if parts else np.zeros((0, width))
 
 
 class GridTooLarge(MemoryError):
@@ -119,6 +132,9 @@ class Grid:
         uniform on [0, kappa zbar]: a start away from every stationary state, whose mean
         margin is half the V -> infinity one, for transients and convergence tests).
     """
+
+    #: kernel steps per call of the kernel (tuned by :meth:`advance`)
+    _chunk_steps: int = CHUNK_FIRST
 
     def __init__(self, model: Model, settings: GridSettings, initial: str = "frozen") -> None:
         if initial not in ("frozen", "relaxed", "uniform"):
@@ -455,34 +471,61 @@ class Grid:
         rec = np.zeros((8192, 5))
         shk = np.zeros((1024, 4))
         seen_shocks = 0
-        while True:
-            self.ist[K.I_NREC] = 0
-            self.ist[K.I_NSHOCK] = 0
-            remaining_shocks = stop_after_shocks - seen_shocks if stop_after_shocks > 0 else 0
-            code = K.advance(
-                self.bufM, self.bufW, self.bufO, self.bufchi, self.bufclo, self.ist, self.fst, self.prm,
-                self.table, self.ex_m, self.ex_y, self.ex_d, self.cand, float(velocity), float(t_stop), max_steps,
-                self.cols_needed, rec, float(record_dt), shk, remaining_shocks,
-            )
-            n_rec = int(self.ist[K.I_NREC])
-            n_shk = min(int(self.ist[K.I_NSHOCK]), shk.shape[0])
-            if n_rec:
-                records.append(rec[:n_rec].copy())
-            if n_shk:
-                shocks.append(shk[:n_shk].copy())
-            seen_shocks += n_shk
-            if code in (K.NEED_ROWS, K.NEED_COLS):
-                self._tighten_extents()
-            if code == K.NEED_ROWS:
-                self._grow_rows()
-            elif code == K.NEED_COLS:
-                self._recentre_or_grow_cols()
-            elif code in (K.RECORDS_FULL, K.SHOCKS_FULL):
-                continue
-            elif code == K.INTERNAL_ERROR:
-                raise RuntimeError("internal error in the Fokker-Planck kernel: a synchronisation left the grid")
-            else:
-                break
-        out_rec = np.concatenate(records) if records else np.zeros((0, 5))
-        out_shk = np.concatenate(shocks) if shocks else np.zeros((0, 4))
+        steps_left = int(max_steps)
+        try:
+            while True:
+                self.ist[K.I_NREC] = 0
+                self.ist[K.I_NSHOCK] = 0
+                remaining_shocks = stop_after_shocks - seen_shocks if stop_after_shocks > 0 else 0
+                # the kernel runs at most `chunk` steps per call, about CHUNK_SECONDS of wall
+                # time, then comes back here (Ctrl-C, progress); stopping between two steps and
+                # going on gives the same result to the last bit
+                chunk = min(self._chunk_steps, steps_left)
+                steps_before = int(self.ist[K.I_STEPS])
+                started = time.perf_counter()
+                code = K.advance(
+                    self.bufM, self.bufW, self.bufO, self.bufchi, self.bufclo, self.ist, self.fst, self.prm,
+                    self.table, self.ex_m, self.ex_y, self.ex_d, self.cand, float(velocity), float(t_stop), chunk,
+                    self.cols_needed, rec, float(record_dt), shk, remaining_shocks,
+                )
+                done = int(self.ist[K.I_STEPS]) - steps_before
+                steps_left -= done
+                self._tune_chunk(done, time.perf_counter() - started, code == K.MAX_STEPS)
+                n_rec = int(self.ist[K.I_NREC])
+                n_shk = min(int(self.ist[K.I_NSHOCK]), shk.shape[0])
+                if n_rec:
+                    records.append(rec[:n_rec].copy())
+                if n_shk:
+                    shocks.append(shk[:n_shk].copy())
+                seen_shocks += n_shk
+                _progress.beat()
+                if code in (K.NEED_ROWS, K.NEED_COLS):
+                    self._tighten_extents()
+                if code == K.NEED_ROWS:
+                    self._grow_rows()
+                elif code == K.NEED_COLS:
+                    self._recentre_or_grow_cols()
+                elif code in (K.RECORDS_FULL, K.SHOCKS_FULL):
+                    continue
+                elif code == K.MAX_STEPS and steps_left > 0:
+                    continue  # (the end of a chunk, not of the caller's budget)
+                elif code == K.INTERNAL_ERROR:
+                    raise RuntimeError("internal error in the Fokker-Planck kernel: a synchronisation left the grid")
+                else:
+                    break
+        except KeyboardInterrupt:
+            # keep what was recorded: the caller may write it (micro run, Ctrl-C)
+            raise Interrupted(records=_joined(records, 5), shocks=_joined(shocks, 4)) from None
+        out_rec = _joined(records, 5)
+        out_shk = _joined(shocks, 4)
         return out_rec, out_shk, code
+
+    def _tune_chunk(self, steps: int, seconds: float, whole: bool) -> None:
+        """Steps per kernel call for about :data:`micro._progress.CHUNK_SECONDS` of wall
+        time, from the last call's rate (only a call that ran its whole chunk tells it)."""
+        if whole and steps > 0:
+            target = steps * _progress.CHUNK_SECONDS / max(seconds, 1e-6)
+            self._chunk_steps = int(min(max(target, CHUNK_MIN), 4.0 * steps, CHUNK_MAX))
+        elif seconds > 2.0 * _progress.CHUNK_SECONDS and steps > 0:
+            self._chunk_steps = int(max(steps * _progress.CHUNK_SECONDS / seconds, CHUNK_MIN))
+

@@ -24,6 +24,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ._progress import Interrupted, reporting
 from .stability import critical_velocity
 from .laws import (PAPER_A, PAPER_B, PAPER_DC, PAPER_K0_MAX, HyperbolicLaw, LogLaw, TabulatedLaw,
                    ViscoelasticLaw)
@@ -298,11 +299,11 @@ def _options(args: argparse.Namespace) -> SolverOptions:
                              v_max=args.v_max, max_rhs_evals=args.max_rhs_evals)
 
 
-def _write(frame, out: _outputs.Target | str | None, note: str = "") -> None:
+def _write(frame, out: _outputs.Target | str | None, note: str = "", *, quiet: bool = False) -> None:
     """By the policy of every output (:mod:`rsf._outputs`): a regular file atomically (its
     owner and mode kept, a symbolic link written through), standard output (``-``, None),
-    a device or a FIFO in place.  The count of rows goes to standard error, so that
-    standard output carries nothing but data."""
+    a device or a FIFO in place.  The count of rows goes to standard error (unless
+    ``quiet``), so that standard output carries nothing but data."""
     if not isinstance(out, _outputs.Target):
         out = _outputs.target("-" if out is None else out, "--out", what="CSV file", probe=False)
 
@@ -311,7 +312,7 @@ def _write(frame, out: _outputs.Target | str | None, note: str = "") -> None:
             frame.to_csv(f, index=False)
 
     _outputs.write(out, fill)
-    if out.given != "-":
+    if out.given != "-" and not quiet:
         print(f"wrote {len(frame)} rows to {out}{note}", file=sys.stderr)
 
 
@@ -576,6 +577,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(_option_values(sys.argv[1:] if argv is None else list(argv), parser))
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    kept: list[str] = []  # what a Ctrl-C leaves on disk
+    try:
+        with reporting(_progress_line(f"rsf {args.command}"), first=0.2, interval=1.0, longest=10.0):
+            return _run(args, kept)
+    except KeyboardInterrupt:
+        print(f"interrupted: {kept[-1] if kept else 'nothing was finished, nothing written'}", file=sys.stderr)
+        return 130
+
+
+def _progress_line(prefix: str):
+    """The command line's progress callback: one line on stderr per report (every second
+    at first, then every 2, 4, ... up to 10 seconds)."""
+    def show(text: str, elapsed: float) -> None:
+        print(f"{prefix}: {text} [{elapsed:.0f} s]", file=sys.stderr, flush=True)
+    return show
+
+
+def _kept(frame, out: str | None, what: str, kept: list[str]) -> None:
+    """After a Ctrl-C: write ``frame`` (the finished part) to ``out`` and say so in ``kept``."""
+    if frame is None or not len(frame):
+        return
+    _write(frame, out, quiet=True)  # (the Ctrl-C's one line says it)
+    kept.append(f"{what} written to {out or 'standard output'}")
+
+
+def _run(args: argparse.Namespace, kept: list[str]) -> int:
+    """The command of ``args`` (``kept`` gets a line saying what is on disk, for a Ctrl-C)."""
     try:
         # everything is checked before anything is computed
         out, events = _outputs_of(args)
@@ -605,7 +633,13 @@ def main(argv: Sequence[str] | None = None) -> int:
                 model.law.check_velocities(velocities, "--V")
             for V in velocities:     # a stick-slip double precision cannot resolve: refused now
                 model.check_resolved(float(V), _resolve_names("--V" if args.V is not None else "--V-range"))
-            result = sweep(model, velocities, options=options, progress=args.verbose)
+            try:
+                result = sweep(model, velocities, options=options, progress=args.verbose)
+            except Interrupted as stop:
+                done = stop.partial.get("result")
+                _kept(done.to_frame() if done else None, out,
+                      f"{len(done.results) if done else 0} of {len(velocities)} rows finished and", kept)
+                raise
             _write(result.to_frame(), out)
             if not result.all_converged:
                 print(f"warning: {result.message}", file=sys.stderr)
@@ -618,7 +652,18 @@ def main(argv: Sequence[str] | None = None) -> int:
             model.law.check_velocities(_driving_velocities(V, protocol), "the driving velocity V")
         for v in _driving_velocities(V, protocol):
             model.check_resolved(float(v), _resolve_names("--V" if V is not None else "the driving velocity"))
-        traj = _simulate_within_budget(model, V, protocol, args.t_end, options, t_eval)
+        try:
+            traj = _simulate_within_budget(model, V, protocol, args.t_end, options, t_eval)
+        except Interrupted as stop:
+            part = stop.partial.get("trajectory")
+            if part is not None and part.t.size:
+                part = part.thinned(_out_dt(args, part.t.size))
+                if events is not None:
+                    _write(part.events_frame(), events, quiet=True)
+                _kept(part.to_frame(), out, f"stopped at t = {part.t[-1]:.6g} of {args.t_end:g}; the "
+                                            f"{part.t.size} rows so far"
+                                            + (f" (and the events, to {events})" if events is not None else ""), kept)
+            raise
         steps = traj.t.size
         out_dt = _out_dt(args, steps)
         traj = traj.thinned(out_dt)

@@ -15,6 +15,7 @@ import logging
 import math
 from dataclasses import dataclass, field
 
+from . import _progress
 from .engines import Engine, Stop
 from .params import SolverOptions
 from .results import Event, Status
@@ -96,6 +97,7 @@ class CycleSearch:
         while True:
             ev = engine.step(math.inf, stop_on_min=True)
             n_events += 1
+            _progress.beat()
             if n_events > options.max_events:
                 self.status = Status.MAX_EVENTS
                 return

@@ -18,6 +18,7 @@ from typing import Iterable
 
 import numpy as np
 
+from . import _progress
 from ._validation import positive
 from .cycles import CycleSearch
 from .engines import Stop, make_engine
@@ -141,36 +142,89 @@ def simulate(model: SpringSlider, V: float | None = None, *, t_end: float,
                          "effect a > 0; for a = 0 use piecewise-constant steps")
     for v in np.unique(protocol.velocities[protocol.velocities > 0.0]):
         model.check_resolved(float(v))
-    engine = make_engine(model, protocol, options, record=True, stop_at_steady=stop_at_steady,
-                         t_eval=t_eval)
-    engine.start(initial)
+    started = time.perf_counter()
+    with _progress.stage("loading the integrator"):
+        engine = make_engine(model, protocol, options, record=True, stop_at_steady=stop_at_steady,
+                             t_eval=t_eval)
+        engine.start(initial)
     status = Status.TIME_LIMIT
     detail = ""
+    n = 0
+
+    def trajectory(message: str = "") -> Trajectory:
+        t, x, sigma, theta, v = engine.samples.arrays()
+        message = message or STATUS_MESSAGES[status] + (f" ({detail})" if detail else "")
+        theta2 = engine.samples.theta2_array() if model.second_state is not None else None
+        return Trajectory(t=t, x=x, sigma=sigma, theta=theta, v=v, theta2=theta2, events=engine.events,
+                          status=status, message=message, params=model.describe())
+
     try:
-        n = 0
-        while True:
-            ev = engine.step(t_end)
-            n += 1
-            if ev.kind == "end":
-                break
-            if ev.kind == "steady":
-                status = Status.STEADY
-                break
-            if n >= options.max_events:
-                status = Status.MAX_EVENTS
-                break
+        with _progress.stage(lambda: _time_done(engine.t, t_end, n, started)):
+            while True:
+                ev = engine.step(t_end)
+                n += 1
+                _progress.beat()
+                if ev.kind == "end":
+                    break
+                if ev.kind == "steady":
+                    status = Status.STEADY
+                    break
+                if n >= options.max_events:
+                    status = Status.MAX_EVENTS
+                    break
+                if n in _PROJECT_AT and protocol.is_constant:
+                    too_many = _too_many_events(n, engine.t, t_end, options.max_events, started)
+                    if too_many:
+                        status, detail = Status.MAX_EVENTS, too_many
+                        break
     except Stop as stop:
         status, detail = stop.status, stop.detail
-    t, x, sigma, theta, v = engine.samples.arrays()
-    message = STATUS_MESSAGES[status] + (f" ({detail})" if detail else "")
+    except KeyboardInterrupt:
+        # Ctrl-C: the samples so far, for a caller that keeps them (rsf run writes them)
+        # (a failure status: it did not reach t_end; the message says why)
+        status = Status.MAX_EVENTS
+        raise _progress.Interrupted(trajectory=trajectory(f"interrupted (Ctrl-C) at t = {engine.t:.6g}")) from None
+    run = trajectory()
     if status < 0:
-        logger.warning("simulate: %s", message)
-    theta2 = engine.samples.theta2_array() if model.second_state is not None else None
+        logger.warning("simulate: %s", run.message)
     velocities = np.asarray(protocol.velocities, dtype=float)
-    _check_table(model, velocities[velocities > 0.0], np.concatenate([theta, [e.theta for e in engine.events]]),
+    _check_table(model, velocities[velocities > 0.0], np.concatenate([run.theta, [e.theta for e in engine.events]]),
                  "simulate")
-    return Trajectory(t=t, x=x, sigma=sigma, theta=theta, v=v, theta2=theta2, events=engine.events,
-                      status=status, message=message, params=model.describe())
+    return run
+
+
+#: Event counts at which :func:`simulate` projects the events of the whole run (constant
+#: driving): a run that would need more than PROJECT_FACTOR times ``max_events`` stops there
+#: instead of after them (near k_c the cycle's period is tiny: k0 = 0.3739316239, V = 0.078
+#: has a period of 5.7e-5, so t_end = 1000 spans 1.8e7 cycles, 5.3e7 events, which the
+#: event budget of 2e6 would stop after about 40 minutes, at t = 38).
+_PROJECT_AT = (2_000, 20_000, 200_000)
+PROJECT_FACTOR = 4.0
+
+
+def _too_many_events(n: int, t: float, t_end: float, max_events: int, started: float) -> str:
+    """Why a run at constant driving that has had ``n`` events by time ``t`` cannot reach
+    ``t_end`` within ``max_events`` (its events projected at the rate so far, with a margin
+    of :data:`PROJECT_FACTOR`), or "" if it may."""
+    if not t > 0.0:
+        return ""
+    projected = n * t_end / t
+    if projected <= PROJECT_FACTOR * max_events:
+        return ""
+    hours = (time.perf_counter() - started) / n * max_events / 3600.0
+    return (f"stopped at t = {t:.6g} after {n} events: at that rate t_end = {t_end:g} needs about "
+            f"{projected:.2g} events, more than max_events = {max_events} (about {t / n:.2g} time units "
+            f"per event; the budget alone would take about {hours:.2g} h and end near t = "
+            f"{t * max_events / n:.3g}); a shorter t_end, or the attractor from limit_cycle / rsf sweep")
+
+
+def _time_done(t: float, t_end: float, n: int, started: float) -> str:
+    """``t = 3.2 of 20 (16 %), 1234 events, ETA 41 s``: the simulated time against its end,
+    the ETA at the mean rate so far."""
+    t = min(max(t, 0.0), t_end)
+    elapsed = time.perf_counter() - started
+    eta = f", ETA {elapsed * (t_end - t) / t:.0f} s" if t > 0.0 else ""
+    return f"t = {t:.6g} of {t_end:g} ({100.0 * t / t_end:.0f} %), {n} events{eta}"
 
 
 def _check_t_eval(t_eval, t_end: float) -> np.ndarray | None:
@@ -253,8 +307,9 @@ def limit_cycle(model: SpringSlider, V: float, *, initial: InitialState | None =
     engine.start(initial)
     params = model.describe()
     params["V"] = V
-    search = CycleSearch(engine, V, options, smooth=model.a > 0.0,
-                         progress_every=_PROGRESS_CYCLES).run()
+    search = CycleSearch(engine, V, options, smooth=model.a > 0.0, progress_every=_PROGRESS_CYCLES)
+    with _progress.stage(lambda: f"limit cycle at V={V:.10g}: {len(search.cycles)} cycles, t = {engine.t:.6g}"):
+        search.run()
     status = search.status
     run_time = time.perf_counter() - started
     message = STATUS_MESSAGES[status] + (f" ({search.detail})" if search.detail else "")
@@ -326,8 +381,14 @@ def sweep(model: SpringSlider, velocities: Iterable[float], *, options: SolverOp
     for V in vel:     # every velocity before the first is computed
         model.check_resolved(V)
     results = []
-    for i, V in enumerate(vel):
-        results.append(limit_cycle(model, V, initial=initial, options=options))
-        if progress and (i + 1) % max(1, len(vel) // 10) == 0:
-            logger.info("sweep: %d / %d velocities done", i + 1, len(vel))
+    try:
+        for i, V in enumerate(vel):
+            with _progress.stage(f"V {i + 1} of {len(vel)}"):
+                results.append(limit_cycle(model, V, initial=initial, options=options))
+            if progress and (i + 1) % max(1, len(vel) // 10) == 0:
+                logger.info("sweep: %d / %d velocities done", i + 1, len(vel))
+    except KeyboardInterrupt:
+        # Ctrl-C: the finished points, for a caller that keeps them (rsf sweep writes them)
+        raise _progress.Interrupted(result=SweepResult(results=results, params=model.describe())
+                                    if results else None) from None
     return SweepResult(results=results, params=model.describe())

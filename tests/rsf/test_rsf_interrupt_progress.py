@@ -1,0 +1,74 @@
+"""rsf's command line: progress within seconds, Ctrl-C (exit 130 within seconds, one line,
+no traceback, the finished work kept), and a run that needs far more events than its
+budget says so at once (issue 54: D7, D13).  Bounds are generous (a loaded two-core
+machine)."""
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from _interrupting import ROOT, interrupt_after  # noqa: E402
+
+FIRST_PROGRESS = 15.0
+STOP = 3.0
+NEAR_KC = ["--k0", "0.3739316239", "--V", "0.078"]
+
+
+def _one_line(text: str) -> str:
+    assert "Traceback" not in text, text
+    lines = [ln for ln in text.splitlines() if ln.strip() and not re.search(r" s\]$", ln)]
+    assert len(lines) == 1, text
+    return lines[0]
+
+
+def test_run_shows_progress_and_stops_keeping_the_samples(tmp_path):
+    # D13: Ctrl-C on rsf run printed a traceback; D7: silent, even with -v
+    run = interrupt_after("rsf", ["run", *NEAR_KC, "--t-end", "0.5", "--out", "r.csv", "--events", "e.csv"],
+                          cwd=tmp_path, wait_for=r"t = (?!0 )\S+ of 0.5 .*[1-9]\d* events.* s\]$")
+    assert run.first_progress < FIRST_PROGRESS
+    assert run.returncode == 130 and run.stop_time < STOP
+    line = _one_line(run.after)
+    m = re.fullmatch(r"interrupted: stopped at t = (\S+) of 0.5; the (\d+) rows so far \(and the events, "
+                     r"to e.csv\) written to r.csv", line)
+    assert m, line
+    rows = pd.read_csv(tmp_path / "r.csv")
+    assert len(rows) == int(m.group(2)) > 0 and np.all(np.diff(rows.t) >= 0)
+    events = pd.read_csv(tmp_path / "e.csv")
+    assert len(events) > 1 and events.t.iloc[-1] <= float(m.group(1)) * (1 + 1e-5)  # (6 digits)
+
+
+def test_sweep_stops_keeping_the_finished_rows(tmp_path):
+    # (near k_c a point takes 227 cycles, about half a second: 30 times the same point)
+    run = interrupt_after("rsf", ["sweep", *NEAR_KC[:2], "--V", ",".join(["0.078"] * 30), "--out", "s.csv"],
+                          cwd=tmp_path, wait_for=r"V [3-9]\d* of 30 .* s\]$")
+    assert run.first_progress < FIRST_PROGRESS
+    assert run.returncode == 130 and run.stop_time < STOP
+    line = _one_line(run.after)
+    m = re.fullmatch(r"interrupted: (\d+) of 30 rows finished and written to s.csv", line)
+    assert m, line
+    rows = pd.read_csv(tmp_path / "s.csv")
+    assert len(rows) == int(m.group(1)) >= 2
+    assert (rows.V == 0.078).all() and (rows.n_cycles == 227).all()
+
+
+def test_run_near_kc_that_needs_too_many_events_says_so_in_seconds(tmp_path):
+    # D7: the cycle's period here is 5.7e-5, so t_end = 1000 needs ~5e7 events; the event
+    # budget (2e6) stopped it only after about 40 min.  Now it stops after 2000 events.
+    start = time.monotonic()
+    done = subprocess.run([sys.executable, "-m", "rsf", "run", *NEAR_KC, "--t-end", "1000", "--out", "r.csv"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin", "NUMBA_NUM_THREADS": "1"})
+    assert time.monotonic() - start < 60
+    assert done.returncode == 3, done.stderr
+    m = re.search(r"t_end = 1000 needs about (\S+) events, more than max_events = 2000000", done.stderr)
+    assert m, done.stderr
+    assert 2e7 < float(m.group(1)) < 1e8  # (1000 / 5.66e-5 cycles, three events each)
+    assert "Traceback" not in done.stderr
+    assert len(pd.read_csv(tmp_path / "r.csv")) > 0
