@@ -28,7 +28,6 @@ import datetime
 import subprocess
 import sys
 
-import numpy as np
 import pandas as pd
 
 import micro
