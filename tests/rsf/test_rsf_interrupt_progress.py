@@ -60,15 +60,34 @@ def test_sweep_stops_keeping_the_finished_rows(tmp_path):
 
 def test_run_near_kc_that_needs_too_many_events_says_so_in_seconds(tmp_path):
     # D7: the cycle's period here is 5.7e-5, so t_end = 1000 needs ~5e7 events; the event
-    # budget (2e6) stopped it only after about 40 min.  Now it stops after 2000 events.
+    # budget (2e6) stopped it only after about 40 min.  The command line now refuses it
+    # after its first 1000 events, with the t_end the budget reaches (exit 2, nothing
+    # written); rsf.simulate itself stops after 2000 events with the projection (exit 3 of
+    # a run, for a caller of the API)
     start = time.monotonic()
     done = subprocess.run([sys.executable, "-m", "rsf", "run", *NEAR_KC, "--t-end", "1000", "--out", "r.csv"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120,
                           env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin", "NUMBA_NUM_THREADS": "1"})
     assert time.monotonic() - start < 60
-    assert done.returncode == 3, done.stderr
-    m = re.search(r"t_end = 1000 needs about (\S+) events, more than max_events = 2000000", done.stderr)
+    assert done.returncode == 2, done.stderr
+    m = re.search(r"--t-end 1000 is beyond the event budget: .* would need about (\S+) events, more than the "
+                  r"2000000 allowed .*; give --t-end <= (\S+)", done.stderr)
     assert m, done.stderr
     assert 2e7 < float(m.group(1)) < 1e8  # (1000 / 5.66e-5 cycles, three events each)
+    assert 20.0 < float(m.group(2)) < 100.0
     assert "Traceback" not in done.stderr
-    assert len(pd.read_csv(tmp_path / "r.csv")) > 0
+    assert not (tmp_path / "r.csv").exists()
+
+
+def test_simulate_that_needs_too_many_events_stops_early_with_its_projection():
+    import rsf
+
+    args = dict(zip(NEAR_KC[::2], NEAR_KC[1::2]))
+    model = rsf.SpringSlider(k0=float(args["--k0"]))
+    start = time.monotonic()
+    run = rsf.simulate(model, float(args["--V"]), t_end=1000.0)
+    assert time.monotonic() - start < 60
+    assert run.status == rsf.results.Status.MAX_EVENTS
+    m = re.search(r"t_end = 1000 needs about (\S+) events, more than max_events = 2000000", run.message)
+    assert m, run.message
+    assert 2e7 < float(m.group(1)) < 1e8
