@@ -406,7 +406,11 @@ def critical_velocity(model: micro.Model, res: Resolution = Resolution(), *, rto
             return math.exp(lv)
         x2 = x1 - f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else x1 + (x1 - x0)
         x2 = min(max(x2, x1 - 1.0), x1 + 1.0)  # at most a factor e per step
-        x2 += 1e-9 * (x2 - x1)  # overshoot a little, so that the next pair brackets the root
+        # overshoot a little, towards where b - 1 changes sign (b falls as V rises), so that the
+        # next pair brackets the root: by at least 1e-10 in log V, because the secant can also
+        # converge onto the root from one side (k0 = 0.4375, k1 = 0, k2 = 0.5, zbar = 0.25: b - 1
+        # = -4e-17, -8e-18, then no step at all and "no sign change" after 60 iterations)
+        x2 += (1.0 if f1 > 0.0 else -1.0) * max(1e-9 * abs(x2 - x1), 1e-10)
         x0, x1 = x1, x2
     raise RuntimeError("critical_velocity: no sign change of b - 1 found")  # pragma: no cover
 

@@ -92,10 +92,14 @@ def test_slow_large_velocity_limit_at_V_1000():
 def test_slow_small_velocity_limit():
     # k0 > k2, V -> 0: sigma = f_th - (k0 + k1) <z^2>/(2<z>) - eta_u V + O(V^2).  The limit
     # and its eta_u V term are tested exactly on the direct method (test_renewal.py: the
-    # O(V^2) remainder); here the FP meets the exact stress at V = 0.002 (0.2 below the fast
-    # limit's, 5 min at eps = 0.016).  Measured: 1.4e-3 off, 70 % of the eta_u V term: at
-    # this bin the FP cannot resolve that term, only the limit itself.
-    V = 0.002
+    # O(V^2) remainder); here the FP meets the exact stress at V = 0.01, where the limit with
+    # its eta_u V term holds to 8.7e-4 (the O(V^2) remainder) and the stress is 0.081 from the
+    # fast limit's, where the run starts.  Measured at eps = 0.016: 5.5e-4 off, 70 CPU s.
+    # (It ran at V = 0.002 until issue 53: 1.4e-3 off, 335 CPU s, too long for the CI's slow
+    # tier; the FP's error there is 70 % of the eta_u V term, so that run did not resolve
+    # more than the limit either.)
+    V = 0.01
     exact = float(micro.steady_sliding(STIFF, V, growth_rate=False).sigma)
-    assert abs(exact - micro.sigma_slow_limit(STIFF, V)) < 5e-5
-    assert _steady(STIFF, V, 0.016) == pytest.approx(exact, abs=2e-3)
+    assert abs(exact - micro.sigma_slow_limit(STIFF, V)) < 1.5e-3
+    assert abs(exact - micro.sigma_fast_limit(STIFF)) > 0.05
+    assert _steady(STIFF, V, 0.016) == pytest.approx(exact, abs=1.5e-3)

@@ -110,6 +110,14 @@ def test_reference_critical_velocity_meets_the_small_k0_asymptote(k1, k2):
     assert 0.0 < dev[1] < 3e-4 and dev[0] / dev[1] == pytest.approx(10.0, rel=0.01)
 
 
+def test_reference_critical_velocity_where_its_secant_meets_the_root_from_one_side():
+    # k0 close to k2 (V^c 0.0248, far below the large-V start 0.143): the secant steps reached
+    # b - 1 = -8e-18 from above V^c without bracketing it and stopped moving, and the search
+    # raised "no sign change" (found by tests/micro/test_physics_properties.py's hypothesis test)
+    model = micro.Model(k0=0.4375, k1=0.0, k2=0.5, jumps=micro.Exponential(0.25, 25.0))
+    assert IR.critical_velocity(model) == pytest.approx(micro.critical_velocity(model).Vc, rel=1e-9)
+
+
 def test_reference_has_no_stick_slip_for_stiff_drive():
     # k0 >= k2: the reference's own b stays below 1 down to V = 1e-4, so V^c = 0 is right
     for k0 in (0.3, 0.1):
