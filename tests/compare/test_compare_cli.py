@@ -37,6 +37,7 @@ def test_bad_option_value_is_a_clear_error(tmp_path):
     assert proc.returncode == 2 and "k0 must" in proc.stderr
 
 
+@pytest.mark.slow  # (10 s or so: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_shs_scenario_end_to_end(tmp_path):
     """One scenario computes only what its figure needs: the slide-hold-slide run and the
     Eq. (10) law (from the micro steady points); with D_c given, no D_c fit, no other figure."""

@@ -223,7 +223,7 @@ def test_hopf_draws_micros_derived_and_measured_laws(rep):
     assert len(lin) and np.allclose(lin.amplitude / lin.d, (lin.amplitude / lin.d).iloc[0])
     path = Path(transition.__file__).parents[1] / "data" / transition.MEASURED_FILE
     header = [ln for ln in path.read_text().splitlines() if ln.startswith("#")]
-    assert any("python benchmarks/" in ln for ln in header)
+    assert any("python -m studies " in ln for ln in header)
     assert any(re.search(r"20\d\d-\d\d-\d\d", ln) for ln in header)
 
 

@@ -107,6 +107,7 @@ def _fig3_table(model: micro.Model, eps: float, t_max: float) -> pd.DataFrame:
 
 
 # --------------------------------------------------------------------------- the tests
+@pytest.mark.slow  # (10 s or so: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_slide_hold_slide_peak_agrees_with_nblock():
     # eps = 0.016 and 0.008 (about 15 CPU s); the FP at 0.008 is 1.7-1.8e-3 above the N-block
     # (its error measured 2.6-3.6e-3 at eps = 0.016, 0.6-0.9e-3 at 0.004: first order)

@@ -74,6 +74,7 @@ def test_steady_sliding_agrees_with_nblock():
     _check_steady(micro.Model(k0=0.3), 0.4, eps=0.016, n_blocks=20_000, share=0.02)
 
 
+@pytest.mark.slow  # (10 s or so: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_stick_slip_extrema_agree_with_nblock():
     # k0 = 0.1, V = 0.05: cycle amplitude 0.063; the bin error is estimated from eps and
     # 1.5 eps (0.8 |a - b| for order 2); tolerances 1.7e-3 and 2.5e-3, below 4 % of the cycle

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 import micro
 from micro.grid import Grid
@@ -37,6 +38,7 @@ def _one_line(text: str) -> str:
     return lines[0]
 
 
+@pytest.mark.slow  # (10 s or so: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_sweep_near_vc_shows_progress_and_stops_keeping_the_finished_row(tmp_path):
     # D5, D13: the row at V^c (1 - 1e-9) is silent for minutes without progress; a Ctrl-C
     # during it exits 130 with one line, and the finished first row stays in --out
