@@ -432,6 +432,7 @@ def simulate(
     record_dsigma: float | None = None,
     record_dt: float | None = None,
     progress: bool = False,
+    max_wall_time: float | None = None,
 ) -> Run:
     """Run a driving protocol and return the stress time series.
 
@@ -450,6 +451,10 @@ def simulate(
     record_dsigma, record_dt : record the stress whenever it moved by ``record_dsigma``
         and at least every ``record_dt``.
     progress : a progress bar of the simulated time on stderr.
+    max_wall_time : the longest the run may take, in seconds, > 0 (default: no bound): a
+        run whose wall time projected at its pace over its first second exceeds it stops
+        with a ``ValueError`` giving the longest duration the bound allows
+        (:func:`micro.fp.simulate_fp`).
 
     Returns
     -------
@@ -462,8 +467,12 @@ def simulate(
     for name, value in (("record_dsigma", record_dsigma), ("record_dt", record_dt)):
         if value is not None and not (math.isfinite(_number(name, value)) and float(value) > 0.0):
             raise ValueError(f"{name} must be a finite number > 0 (or None for the default), got {_shown(value)}")
+    if max_wall_time is not None and not (math.isfinite(_number("max_wall_time", max_wall_time))
+                                          and float(max_wall_time) > 0.0):
+        raise ValueError(f"max_wall_time must be a finite number > 0 (or None), got {_shown(max_wall_time)}")
     return fp.simulate_fp(model, drive, duration=duration, numerics=numerics, initial=initial,
-                          record_dsigma=record_dsigma, record_dt=record_dt, progress=progress)
+                          record_dsigma=record_dsigma, record_dt=record_dt, progress=progress,
+                          max_wall_time=None if max_wall_time is None else float(max_wall_time))
 
 
 #: The longest simulated time a protocol may ask for (as the command line's).

@@ -25,6 +25,7 @@ import pandas as pd
 from . import _outputs
 from ._progress import Interrupted, reporting
 from .api import critical_velocity, simulate, sweep
+from .fp import TooLong
 from .methods import FP, RETIRED, Auto, Cohort, Convergence, default_eps
 from .params import Deterministic, Exponential, Model
 from .protocols import Drive
@@ -39,6 +40,10 @@ V_RANGE = (1e-6, 1e7)
 K0_MAX = 1e3
 #: Longest simulated time a command accepts (as rsf's t_end): 1e8 relaxation times.
 T_MAX = 1e8
+#: `micro run` refuses a run that would take longer than this many hours at the pace of its
+#: first second (micro.simulate's max_wall_time): a duration mistyped by decades is said at
+#: once, not after an ETA of weeks.
+RUN_HOURS_MAX = 24.0
 
 
 def _floats(text: str, name: str, low: float, high: float) -> list[float]:
@@ -288,7 +293,9 @@ def build_parser() -> argparse.ArgumentParser:
     drive.add_argument("--schedule", help="piecewise drive V1:T1,V2:T2,... (velocity:duration, V in [0, 1e7], total T <= 1e8)")
     drive.add_argument("--shs", nargs=4, type=float, metavar=("V", "SLIDE", "HOLD", "RESUME"),
                        help="slide-hold-slide: drive at V for SLIDE, hold for HOLD, resume for RESUME")
-    r.add_argument("--duration", type=float, help="run length for --V (only), in (0, 1e8]")
+    r.add_argument("--duration", type=float,
+                   help="run length for --V (only), in (0, 1e8]; a run that would take more than "
+                        f"{RUN_HOURS_MAX:g} h at the pace of its first second is refused, with the longest duration allowed")
     r.add_argument("--out", required=True,
                    help="output CSV (- for standard output): t,w,sigma (plus window min/max/mean)")
     return p
@@ -478,7 +485,10 @@ def _run(args, kept: list[str]) -> int:
         _bounded(slide + hold + resume, "--shs SLIDE + HOLD + RESUME", 0.0, T_MAX, open_low=True)
         drive = Drive.slide_hold_slide(v, slide, hold, resume)
     try:
-        run = simulate(models[0], drive, numerics=numerics)
+        run = simulate(models[0], drive, numerics=numerics, max_wall_time=RUN_HOURS_MAX * 3600.0)
+    except TooLong as exc:  # (the option the user typed: --duration, or the protocol's)
+        raise ValueError(str(exc).replace("duration", "--duration" if args.duration is not None else
+                                          "the protocol's duration", 1)) from None
     except Interrupted as stop:
         partial = stop.partial.get("run")
         if partial is not None and len(partial.records):

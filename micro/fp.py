@@ -121,6 +121,7 @@ def simulate_fp(
     record_dsigma: float | None = None,
     record_dt: float | None = None,
     progress: bool = False,
+    max_wall_time: float | None = None,
 ) -> Run:
     """Run a driving protocol and return the stress time series.
 
@@ -136,6 +137,11 @@ def simulate_fp(
     progress : show a progress bar of the simulated time, with its ETA, on stderr (tqdm).
         A watcher thread reads the time while the kernel runs (the kernels release the
         GIL); the computation is the same with or without it.
+    max_wall_time : the longest the run may take, in seconds (default: no bound).  Once it
+        has computed for :data:`PACE_AFTER` seconds, a run whose wall time projected at its
+        pace so far exceeds this stops with a :class:`TooLong` error (a ``ValueError``)
+        that gives the longest duration the bound allows: the pace is measured, not
+        derived (the step depends on how hard the dashpots pull near the threshold).
 
     Returns
     -------
@@ -173,11 +179,22 @@ def simulate_fp(
         found = _density_checks(grid) if checks else {"mass_error": math.nan, "min_mass": math.nan}
         return Run(records=records, shocks=shock_frame, grid=grid, wall_time=time.perf_counter() - start, **found)
 
+    def pace() -> None:
+        elapsed, done = time.perf_counter() - start, grid.t - t0
+        if elapsed < PACE_AFTER or not done > 0.0:
+            return
+        projected = elapsed * drive.duration / done
+        if projected > max_wall_time:
+            raise TooLong(f"duration {drive.duration:g} would take about {_hours(projected)} at the pace of the "
+                          f"first {elapsed:.1f} s (t = {done:.3g} done), more than the {_hours(max_wall_time)} "
+                          f"allowed; give a duration <= {drive.duration * max_wall_time / projected:.3g}")
+
     try:
         with _progress_watch(grid, t0, drive.duration, progress), \
                 _progress.stage(lambda: _time_done(grid.t - t0, drive.duration, start)):
             for seg_start, seg_end, v in drive.boundaries():
-                r, s, code = grid.advance(v, t0 + seg_end, record_dsigma=record_dsigma, record_dt=record_dt)
+                r, s, code = grid.advance(v, t0 + seg_end, record_dsigma=record_dsigma, record_dt=record_dt,
+                                          watch=None if max_wall_time is None else pace)
                 recs.append(r)
                 shocks.append(s)
     except KeyboardInterrupt as stop:
@@ -187,6 +204,18 @@ def simulate_fp(
         shocks.append(partial.get("shocks", np.zeros((0, 4))))
         raise Interrupted(run=run_so_far(checks=False)) from None
     return run_so_far()
+
+
+#: ``max_wall_time``: the seconds of computing after which the pace is judged.
+PACE_AFTER = 1.0
+
+
+class TooLong(ValueError):
+    """A run whose projected wall time exceeds its ``max_wall_time``."""
+
+
+def _hours(seconds: float) -> str:
+    return f"{seconds / 3600.0:.3g} h" if seconds >= 3600.0 else f"{seconds:.3g} s"
 
 
 def _time_done(t: float, total: float, start: float) -> str:

@@ -10,6 +10,7 @@ import logging
 import math
 import time
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -452,6 +453,7 @@ class Grid:
         shock_bins: float = 8.0,
         stop_shift: float = math.inf,
         max_steps: int = 1 << 62,
+        watch: Callable[[], None] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, int]:
         """Advance to ``t_stop`` at constant drive velocity.
 
@@ -461,7 +463,9 @@ class Grid:
         ``t, sigma_before, sigma_after, shift``) are the steps whose cascade shifted delta_F
         by more than ``shock_bins`` bins.  A cascade that has shifted ``stop_shift`` bins
         and goes on stops the advance there, mid-cascade, with code ``STOP_EVENT`` (the
-        rest of its shift is owed).  Returns ``(records, shocks, code)``.
+        rest of its shift is owed).  ``watch``, if given, is called after every chunk of
+        steps (about ``_progress.CHUNK_SECONDS`` of wall time; it may raise to stop the
+        run).  Returns ``(records, shocks, code)``.
         """
         self.prm[K.P_SHOCK] = shock_bins
         self.prm[K.P_STOP_SHIFT] = stop_shift
@@ -499,6 +503,8 @@ class Grid:
                     shocks.append(shk[:n_shk].copy())
                 seen_shocks += n_shk
                 _progress.beat()
+                if watch is not None:
+                    watch()
                 if code in (K.NEED_ROWS, K.NEED_COLS):
                     self._tighten_extents()
                 if code == K.NEED_ROWS:

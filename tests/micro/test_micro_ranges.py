@@ -129,3 +129,33 @@ def test_bad_api_arguments_are_one_error_naming_them(call, message):
         call(micro.Model(k0=0.1))
     assert str(info.value).startswith(message), str(info.value)
     assert "np." not in str(info.value)
+
+
+# --- D20, the Fokker-Planck half: a run far beyond a day is refused at its pace ---------------
+def test_a_run_that_would_take_days_is_refused_after_a_second(tmp_path):
+    """`micro run --k0 1 --V 1e-6 --duration 1e8` showed an ETA of about 1200 h and ran on;
+    now it stops once it has computed for a second, with the duration the 24 h bound
+    allows (its pace measured, not derived), exit 2 and nothing written."""
+    import subprocess
+    import sys
+    import time
+
+    start = time.monotonic()
+    done = subprocess.run([sys.executable, "-m", "micro", "run", "--k0", "1", "--V", "1e-6", "--duration", "1e8",
+                           "--out", "r.csv"], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert time.monotonic() - start < 120
+    assert done.returncode == 2, done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("error: --duration 1e+08 would take about ") and "Traceback" not in done.stderr
+    assert "more than the 24 h allowed; give a duration <= " in last
+    reach = float(last.rsplit("<= ", 1)[1])
+    assert 1.0 < reach < 1e8
+    assert not (tmp_path / "r.csv").exists()
+
+
+def test_max_wall_time_is_checked_and_lets_a_short_run_finish():
+    model = micro.Model(k0=1.0)
+    with pytest.raises(ValueError, match=r"max_wall_time must be a finite number > 0"):
+        micro.simulate(model, 1.0, duration=1.0, max_wall_time=0.0)
+    run = micro.simulate(model, 1.0, duration=0.5, max_wall_time=3600.0)
+    assert run.records.t.iloc[-1] == pytest.approx(0.5)
