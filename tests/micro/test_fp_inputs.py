@@ -125,6 +125,7 @@ def test_a_grid_outgrowing_its_memory_limit_raises_a_clear_error():
         micro.simulate(model, 1.0, duration=0.5, numerics=numerics)
 
 
+@pytest.mark.slow  # (5-8 s: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_a_global_shock_at_small_k0_runs_in_a_small_grid():
     # k0 = 1e-4: a global shock slips ~ 0.1 / k0 = 1000 in one cascade, cut into hundreds
     # of kernel steps by the column recentring.  Two failures it used to show: (i) the

@@ -132,6 +132,7 @@ def test_a_slow_loading_phase_is_not_taken_for_steady_sliding():
     assert not (res.converged and res.regime == "steady")
 
 
+@pytest.mark.slow  # (5-8 s: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_an_unconverged_stick_slip_transient_is_labelled_stick_slip():
     # k0 = 0.1, V = 0.01 (V^c ~ 1.1): cut off after six slow cycles whose amplitude still
     # shrinks towards the limit cycle's.  The amplitude trend alone called it "steady".

@@ -18,6 +18,7 @@ def _steady(model, V, eps, initial="auto"):
     return res.sigma_mean
 
 
+@pytest.mark.slow  # (5-8 s: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_large_velocity_limit_with_its_first_correction():
     # sigma = f_th - kappa <z^2>/(2<z>) + k2 gamma Var(R) / V + O(V^-2); the 1/V term is
     # 1.6e-4 here, so the test tells the corrected limit from the bare one.  The default start
@@ -53,6 +54,7 @@ def test_mean_dashpot_stretch_stays_zero_in_steady_sliding():
     assert res.sigma_mean == pytest.approx(exact, abs=1e-4)
 
 
+@pytest.mark.slow  # (5-8 s: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_small_velocity_stress_with_its_eta_u_V_term():
     # k0 > k2 at V = 0.05: the exact stress (direct method) is 0.033 below the V -> 0 limit
     # f_th - (k0 + k1) <z^2>/(2<z>) (the -eta_u V term, 0.05, and its O(V^2) remainder) and

@@ -276,6 +276,7 @@ def test_tabulated_jumps_meet_the_large_velocity_expansion():
     assert micro.critical_velocity(model).Vc > 0
 
 
+@pytest.mark.slow  # (5-8 s: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_characteristic_function_against_an_open_loop_simulation():
     # the linearised renewal equation, its signs and its closure, against blocks driven by
     # a prescribed oscillating slip velocity.  At k0 = 0.1, V = 2, G(i w) moves from

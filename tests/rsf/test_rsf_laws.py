@@ -111,6 +111,7 @@ def _hyp_dmu(v):
     return -0.007 / (v + 0.078) ** 2
 
 
+@pytest.mark.slow  # (5-8 s: the default tier keeps under 5 minutes; CI runs the slow tier)
 def test_callable_law_jitted_and_pure_python_give_the_paper_cycle():
     law = rsf.CallableLaw(_hyp_mu, _hyp_dmu)
     assert law.jitted
