@@ -5,7 +5,7 @@ A fresh cache, so every micro point is computed.  The report's exact V^c (micro'
 chain) must be micro.critical_velocity's to the last digits and the independent renewal
 reference's (tests/micro/_independent_renewal.py, no code shared) to 1e-9; every table of
 the report is written with its shape.  The shapes are those of the default settings at
-this commit (27 tables): a change of the settings, the scenarios or a table's columns
+this commit (29 tables): a change of the settings, the scenarios or a table's columns
 must update SHAPES on purpose."""
 from __future__ import annotations
 
@@ -27,13 +27,14 @@ ROOT = Path(__file__).resolve().parents[2]
 
 #: (rows, columns) of each table of the default report
 SHAPES = {
-    "critical_velocity": (5, 14), "dc_critical": (5, 8), "dc_fit": (1, 11), "dc_per_k0": (5, 9),
-    "dc_points": (22, 11), "dc_profile": (41, 3), "dc_rms_per_k0": (5, 3), "hopf_fit": (4, 23),
-    "hopf_points": (23, 19), "micro_branch": (315, 15), "micro_points": (22, 28), "micro_spectrum": (17, 8),
-    "phase_laws": (4, 10), "phase_micro": (96, 7), "phase_reference": (76, 13), "phase_rs": (324, 7),
-    "rs_bifurcation": (279, 9), "rs_spectrum": (12, 12), "rs_unstable_band": (5, 3), "settings": (1, 48),
-    "shs_fit": (9, 14), "shs_points": (21, 5), "shs_trace": (3024, 5), "steady_fit": (6, 10),
-    "steady_fit_checks": (6, 12), "steady_fit_residuals": (220, 5), "vc_curves": (24, 5),
+    "critical_velocity": (5, 14), "dc_critical": (5, 8), "dc_fit": (1, 14), "dc_per_k0": (5, 15),
+    "dc_points": (35, 13), "dc_profile": (41, 6), "dc_profile_per_k0": (205, 7), "dc_rms_per_k0": (4, 3),
+    "hopf_fit": (4, 23), "hopf_micro_laws": (129, 5), "hopf_points": (23, 21), "micro_branch": (315, 15),
+    "micro_points": (35, 28), "micro_spectrum": (17, 8), "phase_laws": (4, 10), "phase_micro": (96, 7),
+    "phase_reference": (76, 13), "phase_rs": (324, 7), "rs_bifurcation": (272, 9), "rs_spectrum": (12, 12),
+    "rs_unstable_band": (5, 3), "settings": (1, 48), "shs_fit": (9, 14), "shs_points": (21, 5),
+    "shs_trace": (3024, 5), "steady_fit": (6, 10), "steady_fit_checks": (6, 12), "steady_fit_residuals": (220, 5),
+    "vc_curves": (24, 5),
 }
 FIGURES = ("bifurcation", "critical_velocity", "dc_profile", "hopf", "phase", "shs", "steady_fit")
 
@@ -46,7 +47,7 @@ def default_report(tmp_path_factory):
     proc = subprocess.run([sys.executable, "-m", "compare", "--no-progress", "--out", str(out)], cwd=tmp, env=env,
                           capture_output=True, text=True, timeout=3600)
     assert proc.returncode == 0, proc.stderr[-3000:]
-    assert proc.stdout.strip().splitlines()[-1].startswith(f"wrote {out} (27 tables, 7 figures)"), proc.stdout
+    assert proc.stdout.strip().splitlines()[-1].startswith(f"wrote {out} ({len(SHAPES)} tables, 7 figures)"), proc.stdout
     return out
 
 
