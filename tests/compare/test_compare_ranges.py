@@ -4,7 +4,9 @@ cores), D15 (a D_c outside the fit's range, refused before computing, naming --d
 from __future__ import annotations
 
 import logging
+import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -14,13 +16,8 @@ from compare.runner import Runner
 from compare.cache import NullCache
 from micro._threads import available_cores
 
-
-def _error_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("error: ") and "Traceback" not in err
-    return lines[0]
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from _cli_checks import error_line as _error_line  # noqa: E402
 
 
 @pytest.mark.parametrize("value", ["1e300", "1e-300", "0.6"])

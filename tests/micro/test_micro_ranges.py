@@ -4,6 +4,8 @@ flag (CLI) or the parameter (API) and its range; a V^c outside the searched rang
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -12,13 +14,8 @@ import pytest
 import micro
 from micro.cli import main
 
-
-def _error_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("error: ") and "Traceback" not in err
-    return lines[0]
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from _cli_checks import error_line as _error_line  # noqa: E402
 
 
 # --- D21: negative friction, and zbar against the cutoff ------------------------------------

@@ -5,6 +5,8 @@ as converged."""
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -12,13 +14,8 @@ import rsf
 from rsf.cli import main
 from rsf.results import Status
 
-
-def _error_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("error: ") and "Traceback" not in err
-    return lines[0]
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from _cli_checks import error_line as _error_line  # noqa: E402
 
 
 # --- D8: values that divided by zero -------------------------------------------------------

@@ -5,6 +5,8 @@ from __future__ import annotations
 import io
 import logging
 import re
+import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -13,14 +15,8 @@ import pytest
 import rsf
 from rsf.cli import build_parser, main
 
-
-def _error_line(capsys) -> str:
-    """The one line of a refused call (and nothing else on stderr)."""
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("error: ") and "Traceback" not in err
-    return lines[0]
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from _cli_checks import error_line as _error_line  # noqa: E402
 
 
 # --- row 8: the same file twice ----------------------------------------------------------
