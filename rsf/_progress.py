@@ -64,10 +64,11 @@ class _Reporter:
                     parts.append(s() if callable(s) else s)
                 except Exception:  # a stage's text must never break the computation
                     continue
-            self.due = now + self.interval
-            self.interval = min(2.0 * self.interval, self.longest)
             text = " > ".join(p for p in parts if p)
-            if text:  # (nothing before the first stage: checking the input prints no progress)
+            if text:  # (nothing before the first stage: checking the input prints no progress,
+                # and the first line is still due as soon as a stage begins)
+                self.due = now + self.interval
+                self.interval = min(2.0 * self.interval, self.longest)
                 self.callback(text, now - self.start)
         finally:
             self.lock.release()
