@@ -20,6 +20,7 @@ The obvious entry points::
     state = micro.stationary(model, 5.0)               # steady stress, or sigma_max / sigma_min
     fine = micro.stationary(model, 5.0, method=micro.Cohort(dt=0.005))  # a method's own options
     table = micro.sweep(model, [1.0, 5.0, 20.0])       # one row per V
+    branch = micro.cycle_branch(model, d_min=0.02)     # stick-slip branch towards V^c, with errors
     peaks = micro.slide_hold_slide(model, 1000.0, [0.1, 1.0, 10.0])
 """
 from __future__ import annotations
@@ -33,6 +34,7 @@ from .renewal import (SteadySliding, characteristic_function, growth_rate_near_v
 from .methods import FP, Auto, Cohort, Convergence, Numerics, Renewal, default_eps
 from .results import Critical, CycleFixedPoint, Run, Stationary
 from .api import critical_velocity, simulate, slide_hold_slide, stationary, sweep
+from .branch import Branch, cycle_branch
 
 __all__ = [
     "Model",
@@ -62,6 +64,8 @@ __all__ = [
     "stationary",
     "critical_velocity",
     "sweep",
+    "cycle_branch",
+    "Branch",
     "slide_hold_slide",
     "default_eps",
     "sigma_deterministic_steady",

@@ -10,6 +10,8 @@ question               methods (``"auto"``, the default, first)
                        where neither applies or its state is asked for;
                        ``"cohort"``, ``"fp"``
 :func:`sweep`          as :func:`stationary`, one row per velocity, continued
+:func:`micro.cycle_branch`  the stick-slip branch towards V^c in log d, each point the
+                       default cycle with its errors (:mod:`micro.branch`)
 :func:`critical_velocity`  auto = ``"renewal"`` (exact); ``"fp"`` (bisection)
 :func:`simulate`       auto = ``"fp"`` (the only method that carries a transient)
 :func:`slide_hold_slide`  auto = ``"fp"``

@@ -1,4 +1,4 @@
-"""Command line: ``python -m micro steady|sweep|critical|run``.
+"""Command line: ``python -m micro steady|sweep|branch|critical|run``.
 
 Defaults are the paper's Fig. 4 parameters (k1 = 0.1, k2 = 0.9, zbar = 0.1, exponential
 pinning distances with cutoff 10, eta_u = 1, f_th = 1), and each question's best method
@@ -25,6 +25,7 @@ import pandas as pd
 from . import _outputs
 from ._progress import Interrupted, reporting
 from .api import critical_velocity, simulate, sweep
+from .branch import cycle_branch
 from .fp import TooLong
 from .methods import FP, RETIRED, Auto, Cohort, Convergence, default_eps
 from .params import Deterministic, Exponential, Model
@@ -265,6 +266,23 @@ def build_parser() -> argparse.ArgumentParser:
                    help="output CSV (- for standard output), a file rewritten after every row: k0,k1,k2,zbar,V,"
                         "method,regime,sigma_max,sigma_min,sigma_mean,...,sigma_stderr,discretisation_error,...")
 
+    b = sub.add_parser("branch", help="the stick-slip branch from --V-start towards V^c, point by point in "
+                                      "log d (d = 1 - V/V^c), each point with its errors: one CSV row per point")
+    _model_options(b)
+    b.add_argument("--V-start", type=float, default=None,
+                   help="the first point's drive velocity, in (0, V^c) (default 0.2 V^c)")
+    b.add_argument("--d-min", type=float, default=1e-3,
+                   help="where to stop, d = 1 - V/V^c in (0, 1), below the start's (default 1e-3; today the walk "
+                        "ends at d = 0.02, closer than which the cohort method's discretisation error is not known)")
+    b.add_argument("--max-error", type=float, default=0.1,
+                   help="a point is certified when its fixed-point plus discretisation error is at most this "
+                        "fraction of its amplitude, in (0, 1] (default 0.1); the walk ends at the first that is not")
+    b.add_argument("--max-points", type=int, default=60, help="most points, >= 2 (default 60)")
+    b.add_argument("--out", required=True,
+                   help="output CSV (- for standard output), a file rewritten after every point: k0,k1,k2,zbar,V,d,"
+                        "sigma_max,sigma_min,sigma_before,sigma_after,sigma_mean,period,amplitude,"
+                        "fixed_point_error,discretisation_error,certified,method,n_cycles,wall_time,message")
+
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
                                         "(--method fp: bisection on Fokker-Planck runs, the paper's Appendix B)")
     _model_options(c, k0_list=True)
@@ -330,8 +348,8 @@ def _options(args, models: list[Model]):
     """The method's options from its flags, refusing flags of methods the command does
     not use (all before anything is computed)."""
     fp_used = {"steady": False, "sweep": args.command == "sweep", "critical": getattr(args, "method", "") == "fp",
-               "run": True}[args.command]
-    cohort_used = args.command == "sweep"
+               "run": True, "branch": False}[args.command]
+    cohort_used = args.command in ("sweep", "branch")
     if args.command == "sweep":
         if args.method in RETIRED:
             raise ValueError("--method cycle was retired (its cycles are wrong close to V^c): use --method cohort, "
@@ -446,6 +464,8 @@ def _run(args, kept: list[str]) -> int:
             _write_csv(frame, out)
         print(f"wrote {len(frame)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0 if frame.converged.all() else 3
+    if args.command == "branch":
+        return _branch(args, models[0], cohort, out, kept, start)
     if args.command == "critical":
         _check_critical_range(args)
         rows = []
@@ -501,6 +521,39 @@ def _run(args, kept: list[str]) -> int:
     print(f"wrote {len(run.records)} rows to {out} (eps={eps:g}) in {time.perf_counter() - start:.1f} s",
           file=sys.stderr)
     return 0
+
+
+#: The parameters of micro.cycle_branch and the flags that set them.
+_BRANCH_FLAGS = {"V_start": "--V-start", "d_min": "--d-min", "max_error": "--max-error",
+                 "max_points": "--max-points", "Cohort dt": "--cohort-dt", "Cohort h": "--cohort-h"}
+
+
+def _branch(args, model: Model, cohort: Cohort, out: _outputs.Target, kept: list[str], start: float) -> int:
+    """``micro branch``: the points written after each one; exit 0 when the walk reached
+    --d-min with every point certified, 3 when it ended before (the reason on stderr)."""
+    def point_done(frame: pd.DataFrame) -> None:
+        if out.replaceable:
+            _write_csv(frame, out)
+            kept.append(f"{len(frame)} points finished and written to {out}")
+        last = frame.iloc[-1]
+        print(f"[{len(frame)}, {time.perf_counter() - start:.0f} s] d={last.d:.4g} V={last.V:.6g}: "
+              f"sigma_max={last.sigma_max:.6f}, amplitude={last.amplitude:.3g}, errors "
+              f"{last.fixed_point_error:.1e} (fixed point) + {last.discretisation_error:.1e} (discretisation)"
+              f"{'' if last.certified else ', NOT certified'}", file=sys.stderr)
+
+    try:
+        res = cycle_branch(model, args.V_start, d_min=args.d_min, max_error=args.max_error,
+                           max_points=args.max_points, method=cohort, on_point=point_done)
+    except ValueError as exc:  # (name the flags the user typed)
+        text = str(exc).replace("model: ", "--dist: ", 1)
+        for name, flag in _BRANCH_FLAGS.items():
+            text = re.sub(rf"(?<![-\w]){re.escape(name)}\b", flag, text)
+        raise ValueError(text) from None
+    if not out.replaceable or res.points.empty:
+        _write_csv(res.points, out)
+    print(f"wrote {len(res.points)} points to {out} in {time.perf_counter() - start:.1f} s; {res.reason}",
+          file=sys.stderr)
+    return 0 if res.complete else 3
 
 
 if __name__ == "__main__":  # pragma: no cover
