@@ -13,6 +13,9 @@ V^c                         eta_u (1 - 1e-8) inside                     test_ren
                             proportional to 1 / eta_u: V^c (1 + 1e-8))
 the cohort's sigma_max      + or - 2e-4 on cycle_cohorts' sigma_max     test_cohort_parameters._check (the
                                                                         N-block, N to 1e6)
+the cohort near V^c         + 2e-4 on cycle_cohorts' sigma_max and      test_cycle_vs_nblock_near_vc.compare
+                            sigma_before (k0 = 0.01, d = 0.1; the       (the N-block's limit N -> infinity)
+                            test is in that module)
 an FP transient             k0 (1 + 1e-3) in the Fokker-Planck          test_fp_invariants.check_shock_drops
                             kernels' parameters (the model keeps k0)    (each drop is k0 eps shift)
 ==========================  ==========================================  =====================================
