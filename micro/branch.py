@@ -28,11 +28,12 @@ import time
 from dataclasses import dataclass, field
 from typing import Callable
 
+import numpy as np
 import pandas as pd
 
 from . import _progress
 from .api import NEAR_VC, _check_model, _vc, check_cohort_work, stationary
-from .cohort import not_applicable as cohort_not_applicable
+from .cohort import cycle_multipliers, not_applicable as cohort_not_applicable
 from .methods import Auto, Cohort
 from .params import Model
 
@@ -41,7 +42,7 @@ __all__ = ["Branch", "cycle_branch", "COLUMNS"]
 #: The columns of :attr:`Branch.points` (and of ``python -m micro branch``'s CSV).
 COLUMNS = ("k0", "k1", "k2", "zbar", "V", "d", "sigma_max", "sigma_min", "sigma_before", "sigma_after",
            "sigma_mean", "period", "amplitude", "fixed_point_error", "discretisation_error", "certified",
-           "method", "n_cycles", "wall_time", "message")
+           "floquet_1", "floquet_1_angle", "floquet_2", "method", "n_cycles", "wall_time", "message")
 
 #: The first step in log10 d, and the bounds the adaptive step stays within.
 FIRST_STEP = 0.15
@@ -87,7 +88,8 @@ def _check_d(value, name: str) -> float:
     return float(value)
 
 
-def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method) -> tuple[float, float, Auto]:
+def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method,
+                  multipliers) -> tuple[float, float, Auto]:
     """Every argument, before anything long is computed (V^c takes milliseconds)."""
     _check_model(model)
     why = cohort_not_applicable(model)
@@ -99,6 +101,8 @@ def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method) -
         raise ValueError(f"max_error must be in (0, 1] (a fraction of the amplitude), got {max_error!r}")
     if not (isinstance(max_points, int) and not isinstance(max_points, bool) and max_points >= 2):
         raise ValueError(f"max_points must be an integer >= 2, got {max_points!r}")
+    if not isinstance(multipliers, bool):
+        raise ValueError(f"multipliers must be True or False, got {multipliers!r}")
     if isinstance(method, Cohort):
         method = Auto(cohort=method)
     if not isinstance(method, Auto):
@@ -119,8 +123,10 @@ def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method) -
     return float(V_start), d_min, method
 
 
-def _point(res, d: float, max_error: float) -> dict:
+def _point(res, d: float, max_error: float, multipliers: bool) -> dict:
     m = res.model
+    mu = (cycle_multipliers(res.cycle, k=2) if multipliers and res.cycle is not None and res.converged
+          else np.full(2, np.nan))
     amplitude = res.sigma_max - res.sigma_min
     fixed = float(res.sigma_stderr)
     disc = float(res.discretisation_error)
@@ -130,7 +136,8 @@ def _point(res, d: float, max_error: float) -> dict:
             "sigma_max": res.sigma_max, "sigma_min": res.sigma_min, "sigma_before": res.sigma_before,
             "sigma_after": res.sigma_after, "sigma_mean": res.sigma_mean, "period": res.period,
             "amplitude": amplitude, "fixed_point_error": fixed, "discretisation_error": disc,
-            "certified": certified, "method": res.method, "n_cycles": res.n_cycles,
+            "certified": certified, "floquet_1": float(abs(mu[0])), "floquet_1_angle": float(np.angle(mu[0])),
+            "floquet_2": float(abs(mu[1])), "method": res.method, "n_cycles": res.n_cycles,
             "wall_time": res.wall_time, "message": res.message}
 
 
@@ -172,6 +179,7 @@ def cycle_branch(
     max_error: float = 0.1,
     max_points: int = 60,
     method: Cohort | Auto | None = None,
+    multipliers: bool = False,
     on_point: Callable[[pd.DataFrame], None] | None = None,
 ) -> Branch:
     """The stick-slip branch from ``V_start`` towards ``d_min = 1 - V/V^c``.
@@ -186,6 +194,11 @@ def cycle_branch(
         after the first point that is not.
     max_points : most points computed, >= 2 (default 60).
     method : the cohort method's options (:class:`micro.Cohort`); default its defaults.
+    multipliers : also the cycle map's two leading multipliers at each point (its
+        Floquet multipliers, :func:`micro.cohort.cycle_multipliers`): columns
+        ``floquet_1`` (the largest modulus; the cycle is stable where it is below 1),
+        ``floquet_1_angle`` (its argument, radians) and ``floquet_2``.  About 14 more
+        cycles a point, which doubles its cost far from V^c; NaN when not asked.
     on_point : called with the frame of the points so far after each point (a command line
         writes it, so that a later failure or a kill loses nothing).
 
@@ -203,7 +216,7 @@ def cycle_branch(
     """
     started = time.perf_counter()
     V_start, d_min, opts = _check_inputs(model, V_start, d_min, max_error, max_points,
-                                         Auto() if method is None else method)
+                                         Auto() if method is None else method, multipliers)
     Vc = _vc(model)
     rows: list[dict] = []
     d = 1.0 - V_start / Vc
@@ -221,10 +234,10 @@ def cycle_branch(
         try:
             with _progress.stage(f"point {len(rows) + 1}, d={d:.4g}, V={V:.6g}"):
                 res = stationary(model, V, method=opts, warn=False)
+                row = _point(res, d, max_error, multipliers)
         except (ValueError, ArithmeticError, RuntimeError) as exc:
             reason = f"the point at d = {d:.4g} (V = {V:.10g}) failed: {exc}"
             break
-        row = _point(res, d, max_error)
         if not row["certified"]:
             reason = _not_certified(row, res.regime, max_error)
         rows.append(row)

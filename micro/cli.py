@@ -278,10 +278,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a point is certified when its fixed-point plus discretisation error is at most this "
                         "fraction of its amplitude, in (0, 1] (default 0.1); the walk ends at the first that is not")
     b.add_argument("--max-points", type=int, default=60, help="most points, >= 2 (default 60)")
+    b.add_argument("--multipliers", action="store_true",
+                   help="also the cycle map's two leading (Floquet) multipliers at each point: columns floquet_1 "
+                        "(largest modulus; stable below 1), floquet_1_angle, floquet_2; about 14 more cycles a point")
     b.add_argument("--out", required=True,
                    help="output CSV (- for standard output), a file rewritten after every point: k0,k1,k2,zbar,V,d,"
                         "sigma_max,sigma_min,sigma_before,sigma_after,sigma_mean,period,amplitude,"
-                        "fixed_point_error,discretisation_error,certified,method,n_cycles,wall_time,message")
+                        "fixed_point_error,discretisation_error,certified,floquet_1,floquet_1_angle,floquet_2,"
+                        "method,n_cycles,wall_time,message")
 
     c = sub.add_parser("critical", help="critical velocity Vc: where the branching ratio of steady sliding reaches 1 "
                                         "(--method fp: bisection on Fokker-Planck runs, the paper's Appendix B)")
@@ -539,11 +543,13 @@ def _branch(args, model: Model, cohort: Cohort, out: _outputs.Target, kept: list
         print(f"[{len(frame)}, {time.perf_counter() - start:.0f} s] d={last.d:.4g} V={last.V:.6g}: "
               f"sigma_max={last.sigma_max:.6f}, amplitude={last.amplitude:.3g}, errors "
               f"{last.fixed_point_error:.1e} (fixed point) + {last.discretisation_error:.1e} (discretisation)"
-              f"{'' if last.certified else ', NOT certified'}", file=sys.stderr)
+              + (f", leading multiplier {last.floquet_1:.4f}" if args.multipliers else "")
+              + ("" if last.certified else ", NOT certified"), file=sys.stderr)
 
     try:
         res = cycle_branch(model, args.V_start, d_min=args.d_min, max_error=args.max_error,
-                           max_points=args.max_points, method=cohort, on_point=point_done)
+                           max_points=args.max_points, method=cohort, multipliers=args.multipliers,
+                           on_point=point_done)
     except ValueError as exc:  # (name the flags the user typed)
         text = str(exc).replace("model: ", "--dist: ", 1)
         for name, flag in _BRANCH_FLAGS.items():

@@ -30,7 +30,7 @@ from .params import Model
 __all__ = [
     "CohortState", "NO_COARSE", "start_state", "continued", "one_cycle", "phase_step", "step_off",
     "relaxation_multiplier", "error_estimate", "state_tail", "product_cycle", "carried_cycle",
-    "support", "newton_krylov", "NEWTON_FD_STEP", "gauss_rule",
+    "support", "map_multipliers", "newton_krylov", "NEWTON_FD_STEP", "gauss_rule",
     "quadrature", "map_width", "chain_grid", "chain_on_grid", "waiting_time",
     "correlated_stderr", "drifts",
 ]
@@ -104,6 +104,14 @@ def carried_cycle(base: cohort._Cohorts, step: float, ref: float, v: np.ndarray)
 def support(x: np.ndarray, g: np.ndarray) -> np.ndarray:
     """For studies: the cells the cycle map acts on (``micro.cohort._support``)."""
     return cohort._support(x, g)
+
+
+def map_multipliers(base: cohort._Cohorts, step: float, ref: float, x: np.ndarray, k: int = 3,
+                    ncv: int = 25, tol: float = 1e-4) -> tuple[np.ndarray, int]:
+    """For studies: the ``k`` largest multipliers of the cycle map from ``base`` at the
+    marginal ``x``, and the cycles taken (``micro.cohort._map_multipliers``, which
+    :func:`micro.cohort.cycle_multipliers` uses with a smaller Krylov space)."""
+    return cohort._map_multipliers(base, step, ref, x, k, ncv, tol)
 
 
 def newton_krylov(step: float, dt: float, base: cohort._Cohorts, tol: float, max_evals: int):

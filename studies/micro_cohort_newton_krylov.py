@@ -41,7 +41,6 @@ import os
 
 import numpy as np
 import pandas as pd
-import scipy.sparse.linalg as sla
 
 import micro
 import micro.cohort as C
@@ -77,27 +76,9 @@ def fd_check(base, step, ref) -> list[dict]:
 
 
 def multipliers(base, step, ref, x, k: int = 3) -> tuple[np.ndarray, int]:
-    """The map's ``k`` largest multipliers at ``x`` (Arnoldi on difference quotients) and
-    the cycles used.  The operator is the Jacobian on the nodes where ``x`` holds more than
-    1e-12 of the mass (a perturbation of a node that holds less leaves the domain of
-    positive densities, and its difference quotient is not the Jacobian's)."""
-    G = lambda v: H.carried_cycle(base, step, ref, v)  # noqa: E731
-    _, _, g = G(x)
-    S = np.flatnonzero(x > 1e-12)
-    count = [1]
-
-    def jv(v):
-        full = np.zeros_like(x)
-        full[S] = np.ravel(v)
-        nv = np.abs(full).sum()
-        e = H.NEWTON_FD_STEP / nv
-        count[0] += 1
-        return ((G(x + e * full)[2] - g) / e)[S]
-    A = sla.LinearOperator((S.size, S.size), matvec=jv, dtype=float)
-    # (from the residual's direction: smooth, with tails as small as the marginal's)
-    v0 = (g - x)[S]
-    vals = sla.eigs(A, k=k, which="LM", ncv=25, tol=1e-4, v0=v0 / np.linalg.norm(v0), return_eigenvectors=False)
-    return vals[np.argsort(-np.abs(vals))], count[0]
+    """The map's ``k`` largest multipliers at ``x`` (Arnoldi on difference quotients,
+    ``micro.study_hooks.map_multipliers``: 25 vectors to 1e-4) and the cycles used."""
+    return H.map_multipliers(base, step, ref, x, k)
 
 
 def solve_point(model, V, h_div, dt, consistent, verify, want_multipliers, fd, tol=1e-8,
