@@ -253,7 +253,9 @@ def cycle_branch(
             break
         step = _next_step([r["d"] for r in rows], [r["amplitude"] for r in rows],
                           [r["sigma_max"] for r in rows], step)
-        d = max(floor, d * 10.0 ** (-step))
+        d *= 10.0 ** (-step)
+        if d < floor * 10.0 ** STEP_RANGE[0]:   # (no remainder shorter than the shortest step)
+            d = floor
     frame = pd.DataFrame(rows, columns=COLUMNS)
     return Branch(model=model, Vc=Vc, points=frame, complete=complete, reason=reason,
                   wall_time=time.perf_counter() - started)
