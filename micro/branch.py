@@ -125,8 +125,12 @@ def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method,
 
 def _point(res, d: float, max_error: float, multipliers: bool) -> dict:
     m = res.model
-    mu = (cycle_multipliers(res.cycle, k=2) if multipliers and res.cycle is not None and res.converged
-          else np.full(2, np.nan))
+    mu, note = np.full(2, np.nan), ""
+    if multipliers and res.cycle is not None and res.converged:
+        try:
+            mu = cycle_multipliers(res.cycle, k=2)
+        except (ValueError, ArithmeticError, RuntimeError) as exc:  # (the cycle itself stands)
+            note = f"; multipliers not found: {exc}"
     amplitude = res.sigma_max - res.sigma_min
     fixed = float(res.sigma_stderr)
     disc = float(res.discretisation_error)
@@ -138,7 +142,7 @@ def _point(res, d: float, max_error: float, multipliers: bool) -> dict:
             "amplitude": amplitude, "fixed_point_error": fixed, "discretisation_error": disc,
             "certified": certified, "floquet_1": float(abs(mu[0])), "floquet_1_angle": float(np.angle(mu[0])),
             "floquet_2": float(abs(mu[1])), "method": res.method, "n_cycles": res.n_cycles,
-            "wall_time": res.wall_time, "message": res.message}
+            "wall_time": res.wall_time, "message": res.message + note}
 
 
 def _not_certified(row: dict, regime: str, max_error: float) -> str:

@@ -87,6 +87,23 @@ def test_a_point_that_fails_ends_the_walk_and_keeps_the_points_before(monkeypatc
     assert list(res.points.columns) == list(COLUMNS)
 
 
+def test_multipliers_that_fail_leave_the_point_with_nan_and_a_note(monkeypatch):
+    fake, calls = _fake_stationary(lambda d: 0.9 + 0.1 * d)
+
+    def with_cycle(*args, **kwargs):
+        res = fake(*args, **kwargs)
+        res.cycle = object()
+        return res
+
+    def broken(cycle, k):
+        raise ArithmeticError("a perturbed cycle failed")
+    monkeypatch.setattr(branch_module, "stationary", with_cycle)
+    monkeypatch.setattr(branch_module, "cycle_multipliers", broken)
+    res = cycle_branch(MODEL, d_min=0.5, multipliers=True)
+    assert res.complete and res.points.floquet_1.isna().all()
+    assert res.points.message.str.contains("multipliers not found: a perturbed cycle failed").all()
+
+
 def test_the_walk_ends_at_the_first_point_not_certified_and_keeps_it(monkeypatch):
     # the discretisation error exceeds a tenth of the amplitude 0.1 d once d < 0.3
     fake, calls = _fake_stationary(lambda d: 0.9 + 0.1 * d, disc=lambda d: 0.02 if d < 0.3 else 1e-5)
