@@ -23,7 +23,6 @@ from typing import Iterator
 
 import numpy as np
 import pandas as pd
-from scipy.stats import linregress
 
 from . import _fp_kernels as K
 from . import _progress
@@ -437,9 +436,21 @@ def _amplitude_trend(amp: np.ndarray) -> tuple[float, bool]:
     if k < 6 or not np.all(a > 0.0):
         ratio = float(a[-1] / a[-3]) ** 0.5 if a[-3] > 0 else math.nan
         return ratio, ratio < 0.999
-    fit = linregress(np.arange(k), np.log(a))
-    ratio = float(math.exp(fit.slope))
-    return ratio, bool(fit.slope + 2.0 * fit.stderr < 0.0 and ratio ** k < 0.95)
+    slope, stderr = _slope(np.log(a))
+    ratio = float(math.exp(slope))
+    return ratio, bool(slope + 2.0 * stderr < 0.0 and ratio ** k < 0.95)
+
+
+def _slope(y: np.ndarray) -> tuple[float, float]:
+    """The least-squares slope of ``y`` against 0, 1, 2, ... and its standard error (what
+    ``scipy.stats.linregress`` gives, without importing scipy.stats, 0.35 s of every
+    command's start-up)."""
+    x = np.arange(y.size, dtype=float)
+    x -= x.mean()
+    sxx = float(x @ x)
+    slope = float(x @ (y - y.mean())) / sxx
+    resid = y - y.mean() - slope * x
+    return slope, math.sqrt(float(resid @ resid) / (y.size - 2) / sxx)
 
 
 def _shock_times(shock_rows: list[np.ndarray]) -> np.ndarray:

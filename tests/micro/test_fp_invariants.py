@@ -346,3 +346,17 @@ def test_the_check_at_half_the_bin_brackets_the_n_block_critical_velocity():
         else:  # checked at eps / 2: a physical cycle keeps its amplitude
             keeps = e.amplitude_fine >= solver.REFINE_RATIO * e.amplitude
             assert e.label == ("stick-slip" if keeps else "steady")
+
+
+@pytest.mark.parametrize("n", [6, 9, 40])
+def test_the_amplitude_trend_slope_is_least_squares_with_linregress_error(n):
+    """micro.fp._slope (which spares every command the import of scipy.stats) gives
+    scipy.stats.linregress's slope and standard error."""
+    from scipy.stats import linregress
+
+    from micro.fp import _slope
+    y = np.random.default_rng(n).normal(size=n) + 0.05 * np.arange(n)
+    fit = linregress(np.arange(n), y)
+    slope, stderr = _slope(y)
+    assert slope == pytest.approx(fit.slope, rel=1e-12, abs=1e-14)
+    assert stderr == pytest.approx(fit.stderr, rel=1e-12)
