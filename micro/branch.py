@@ -202,7 +202,8 @@ def cycle_branch(
         Floquet multipliers, :func:`micro.cohort.cycle_multipliers`): columns
         ``floquet_1`` (the largest modulus; the cycle is stable where it is below 1),
         ``floquet_1_angle`` (its argument, radians) and ``floquet_2``.  About 14 more
-        cycles a point, which doubles its cost far from V^c; NaN when not asked.
+        cycles a point, which doubles its cost far from V^c; NaN when not asked, and
+        where the shocks leave more than 1e-3 of the blocks (the message says so).
     on_point : called with the frame of the points so far after each point (a command line
         writes it, so that a later failure or a kill loses nothing).
 
