@@ -655,7 +655,7 @@ def _serial_twins(names):
         twin = types.FunctionType(func.__code__, namespace, name + "_serial", func.__defaults__, func.__closure__)
         twin.__qualname__ = name + "_serial"
         twin.__doc__ = func.__doc__
-        twins[name] = njit(**options)(twin)
+        twins[name] = njit(cache=True, **options)(twin)  # (caching is not among the targetoptions)
     namespace.update(twins)
     return twins
 

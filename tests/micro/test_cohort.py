@@ -191,6 +191,7 @@ def test_serial_twins_are_the_parallel_kernels_bit_for_bit(monkeypatch):
     assert CK._closure.targetoptions["parallel"] and CK._commit.targetoptions["parallel"]
     for entry in (CK.closure, CK.smallest_root, CK.commit):
         assert not entry.serial.targetoptions.get("parallel")
+        assert type(entry.serial._cache) is type(entry.__wrapped__._cache)  # on numba's disk cache as well
     model = micro.Model(k0=0.1)  # some 500 cohorts at V = 1 (a cycle takes 15 s: stopped once all were seen)
     st = _start(model, 1.0, model.kappa * model.zbar, None)
     seen = {"smallest_root": 0, "commit": 0}
