@@ -643,10 +643,6 @@ def execute(task: Task) -> dict[str, Any]:
     return record
 
 
-def _warm_renewal() -> None:
-    micro.steady_sliding(micro.Model(k0=0.1), [0.5, 2.0], warn=False)
-
-
 def _warm_fp() -> None:
     model = micro.Model(k0=0.5)
     micro.simulate(model, 5.0, duration=0.5, numerics=micro.Numerics(eps=model.kappa * model.zbar / 4.0))
@@ -665,12 +661,15 @@ def _warm_nblock() -> None:
 
 
 #: micro's kernels in groups that compile independently, the costliest first (CPU seconds
-#: to compile on one core, measured with an empty numba cache: cohort 15.6, fp 8.2,
-#: nblock 7.8, renewal 1.9).  A pool compiles them on its workers at once
-#: (:meth:`compare.runner.Runner`), and every later process loads them from numba's disk
-#: cache.
+#: to compile on one core, measured with an empty numba cache on an idle machine: cohort
+#: 15.6, fp 8.2, nblock 7.8; cohort 11.9 on a loaded one since its pool workers compile
+#: serial twins of its parallel kernels).  Cohort's run compiles the renewal kernels as
+#: well (micro.stationary calls the renewal chain): a group of their own compiled nothing
+#: after it, and with three workers or more compiled them a second time beside it.  A pool
+#: compiles the groups on its workers at once (:meth:`compare.runner.Runner`), and every
+#: later process loads them from numba's disk cache.
 WARM_GROUPS: dict[str, Callable[[], None]] = {
-    "cohort": _warm_cohort, "fp": _warm_fp, "nblock": _warm_nblock, "renewal": _warm_renewal,
+    "cohort": _warm_cohort, "fp": _warm_fp, "nblock": _warm_nblock,
 }
 
 

@@ -38,7 +38,7 @@ import time
 from typing import Callable, Iterator, TypeVar
 
 __all__ = ["single_blas_thread", "blas_single_threaded", "available_cores", "busy_elsewhere", "free_cores",
-           "numba_threads", "use_free_cores", "single_thread_process", "SAMPLE_SECONDS"]
+           "numba_threads", "one_numba_thread", "use_free_cores", "single_thread_process", "SAMPLE_SECONDS"]
 
 F = TypeVar("F", bound=Callable)
 
@@ -155,6 +155,13 @@ def _numba_limit() -> int:
     from numba import config
 
     return max(1, int(config.NUMBA_NUM_THREADS))
+
+
+def one_numba_thread() -> bool:
+    """Whether numba can run one thread only in this process, for its whole life
+    (``NUMBA_NUM_THREADS=1``, as in compare's pool workers, or a single core): then
+    micro's parallel kernels have serial twins that compile faster."""
+    return _numba_limit() == 1
 
 
 def _sampled() -> tuple[float, int]:

@@ -52,6 +52,14 @@ STICK = 0
 SLIDE = 1
 SLIP = 2
 
+# Kinds of :func:`phase_fn` (and :func:`phase_dfn`, :func:`brentq`, :func:`first_root`):
+# numpy integers, not Python ints, so that numba types them as int64.  A literal 0 or 1
+# in a jitted call is typed as Literal[int], and each of the four kernels was compiled
+# once per literal, twice in all (2.4 CPU seconds for the four with an empty numba cache
+# in compare's rsf warm-up, 1.2 s as int64 only; mean of three runs).
+STICK_FN = np.int64(0)
+SLIP_FN = np.int64(1)
+
 # Flags returned by the root kernels.
 FOUND = 0
 HORIZON = 1       # no root before the time horizon (stick) / runaway slip (slip)
@@ -376,7 +384,7 @@ def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg, concave_sup):
     h = h0
     if h0 >= 0.0:
         t = min(1e-7 * theta0, t_max)
-        h = phase_fn(0, p, t, c)
+        h = phase_fn(STICK_FN, p, t, c)
         if h >= 0.0:
             return 0.0, FOUND
     if concave_sup == concave_sup and k0V > 0.0:
@@ -390,16 +398,16 @@ def stick_end(p, h0, theta0, k0V, Dc, t_max, w_neg, concave_sup):
         for _ in range(2000):
             if t_hi >= t_max:
                 t_hi = t_max
-            h_hi = phase_fn(0, p, t_hi, c)
+            h_hi = phase_fn(STICK_FN, p, t_hi, c)
             if h_hi >= 0.0:
-                return brentq(0, p, c, t, t_hi, h, h_hi), FOUND
+                return brentq(STICK_FN, p, c, t, t_hi, h, h_hi), FOUND
             if t_hi == t_max:
                 return t_max, HORIZON
             t = t_hi
             h = h_hi
             t_hi = 10.0 * t_hi + theta0
         return t, FAILED
-    return first_root(0, p, c, t, t_max, k0V, w_neg, 1.0)
+    return first_root(STICK_FN, p, c, t, t_max, k0V, w_neg, 1.0)
 
 
 @njit(cache=True, nogil=True)
@@ -430,15 +438,15 @@ def slip_end(p, g0, theta0, K, Dc, lipschitz, theta_floor):
         # on the threshold: the slip exists only if g rises just after s = 0
         found = False
         for trial in (1e-8, 1e-6, 1e-4):
-            if trial < s_max and phase_fn(1, p, trial, c) > 0.0:
+            if trial < s_max and phase_fn(SLIP_FN, p, trial, c) > 0.0:
                 s = trial
                 found = True
                 break
         if not found:
             return 0.0, NO_SLIP
-    s, flag = first_root(1, p, c, s, s_max, 0.0, 0.0, lipschitz)
+    s, flag = first_root(SLIP_FN, p, c, s, s_max, 0.0, 0.0, lipschitz)
     if flag == HORIZON:
-        g = phase_fn(1, p, s_max, c)
+        g = phase_fn(SLIP_FN, p, s_max, c)
         d = K - law_eval(Dc / theta_floor, p)[1]
         if d > 0.0:
             return s_max + max(g, 0.0) / d, FLOOR
@@ -469,7 +477,7 @@ def decide(p, theta, K, V, Dc):
         c[1] = theta
         c[2] = K * V / Dc
         c[3] = Dc
-        if phase_fn(0, p, 1e-5 * theta, c) < 0.0:
+        if phase_fn(STICK_FN, p, 1e-5 * theta, c) < 0.0:
             return STICK
     if D > 1e-12 * scale_d:
         return SLIDE
@@ -479,7 +487,7 @@ def decide(p, theta, K, V, Dc):
     c[1] = theta
     c[2] = K
     c[3] = Dc
-    if phase_fn(1, p, 1e-5, c) > 0.0:
+    if phase_fn(SLIP_FN, p, 1e-5, c) > 0.0:
         return SLIP
     return SLIDE
 

@@ -276,3 +276,32 @@ def test_a_fresh_pool_compiles_each_kernel_once_and_every_group_of_them(tmp_path
     assert not twice, f"compiled more than once: {twice}"
     modules = {name.split(".")[0] for name in saved}
     assert {"_cohort_kernels", "_fp_kernels", "_nblock_kernels", "_renewal_kernels"} <= modules
+
+
+@pytest.mark.slow
+def test_every_warm_up_group_brings_kernels_of_its_own():
+    """Run one after another in a fresh process, each group of compare.tasks.WARM_GROUPS
+    loads or compiles kernels the groups before it did not: a group that brought none
+    (the renewal kernels, which cohort's run compiles too) was compiled a second time
+    beside the other group on a pool of three workers or more."""
+    import subprocess
+    import sys
+
+    code = (
+        "import numba\n"
+        "from micro import _cohort_kernels, _fp_kernels, _nblock_kernels, _renewal_kernels\n"
+        "from compare.tasks import WARM_GROUPS, warm_up\n"
+        "mods = (_cohort_kernels, _fp_kernels, _nblock_kernels, _renewal_kernels)\n"
+        "def count():\n"
+        "    return sum(len(f.signatures) for m in mods for f in vars(m).values()\n"
+        "               if isinstance(f, numba.core.registry.CPUDispatcher))\n"
+        "before = count()\n"
+        "for name in WARM_GROUPS:\n"
+        "    warm_up([name])\n"
+        "    print('GROUP', name, count() - before)\n"
+        "    before = count()\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-2000:]
+    added = {line.split()[1]: int(line.split()[2]) for line in out.stdout.splitlines() if line.startswith("GROUP")}
+    assert added and min(added.values()) > 0, added

@@ -184,6 +184,65 @@ def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
     assert seen["warm"] > 20 and seen["shocks"] == 2
 
 
+def test_serial_twins_are_the_parallel_kernels_bit_for_bit(monkeypatch):
+    """Where numba runs one thread only (compare's pool workers) the cohort kernels run as
+    serial twins, which compile faster (no parfors): the same sums in the same order, so
+    the same numbers to the last bit, also from PARALLEL_COHORTS cohorts on."""
+    assert CK._closure.targetoptions["parallel"] and CK._commit.targetoptions["parallel"]
+    for entry in (CK.closure, CK.smallest_root, CK.commit):
+        assert not entry.serial.targetoptions.get("parallel")
+        assert type(entry.serial._cache) is type(entry.__wrapped__._cache)  # on numba's disk cache as well
+    model = micro.Model(k0=0.1)  # some 500 cohorts at V = 1 (a cycle takes 15 s: stopped once all were seen)
+    st = _start(model, 1.0, model.kappa * model.zbar, None)
+    seen = {"smallest_root": 0, "commit": 0}
+
+    class Seen(Exception):
+        pass
+
+    def both(name):
+        entry = getattr(CK, name)
+
+        def call(*args):
+            copies = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+            out = entry.__wrapped__(*args)
+            assert entry.serial(*copies) == out
+            for a, b in zip(args, copies):
+                if isinstance(a, np.ndarray):
+                    assert np.array_equal(a, b, equal_nan=True)
+            if name == "smallest_root":  # and the closure at the root (smallest_root's args less its last three)
+                assert CK._closure(out[0], *args[:-3]) == CK.closure.serial(out[0], *args[:-3])
+            seen[name] += args[1 if name == "commit" else 0] >= CK.PARALLEL_COHORTS
+            if min(seen.values()) >= 20:
+                raise Seen
+            return out
+
+        monkeypatch.setattr(CK, name, call)
+
+    for name in seen:
+        both(name)
+    try:
+        _one_cycle(st, 0.04)
+    except Seen:
+        pass
+    assert min(seen.values()) >= 20, seen
+
+
+def test_one_numba_thread_runs_the_serial_twins(monkeypatch):
+    """The entry points pick the serial twin exactly where numba has one thread for good."""
+    from micro import _threads
+
+    monkeypatch.setattr(_threads, "_numba_limit", lambda: 1)
+    assert CK.one_numba_thread()
+    monkeypatch.setattr(_threads, "_numba_limit", lambda: 2)
+    assert not CK.one_numba_thread()
+    calls = []
+    monkeypatch.setattr(CK, "one_numba_thread", lambda: calls.append(1) or True)
+    i64 = np.zeros(1, np.int64)
+    args = (0.5, 0, np.zeros((1, 6)), i64, i64.copy(), i64.copy(), np.zeros(2), np.zeros(4), 0.0, 0.1, 0.1, 0.1)
+    assert CK.closure(*args) == (-0.5, -1.0) and calls
+    assert CK.closure.serial.signatures
+
+
 @pytest.mark.parametrize("coarse", [True, pytest.param(False, marks=pytest.mark.slow)])  # (18 s: the default run
 # keeps the start from a coarse run, the default path)
 def test_a_short_loading_phase_gets_its_steps_from_the_cycle_not_from_the_transient(coarse):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 import pytest
 
@@ -105,3 +106,15 @@ def test_decide_follows_the_signs_of_N_and_D():
 
 def test_law_eval_dispatch_rejects_unknown_code():
     assert all(math.isnan(x) for x in K.law_eval(1.0, np.array([99.0])))
+
+
+def test_root_kernels_compile_once_for_both_phases():
+    # stick_end and slip_end hand phase_fn's kind as int64: a Python literal 0 or 1 made
+    # numba compile phase_fn, phase_dfn, brentq and first_root once per literal
+    m, p = _model(0.3)
+    K.stick_end(p, -0.01, 1.0, m.k0 * 0.1, m.Dc, 1e9, 0.0, math.nan)
+    K.slip_end(p, 0.02, 1.0, m.K, m.Dc, m.K + m.law.weakening_bounds()[1], 1e-250 * m.Dc)
+    K.decide(p, 1.0, m.K, 0.1, m.Dc)
+    for kernel in (K.phase_fn, K.phase_dfn, K.brentq, K.first_root):
+        kinds = {sig[0] for sig in kernel.signatures}
+        assert kinds == {numba.int64}, (kernel.__name__, kinds)
