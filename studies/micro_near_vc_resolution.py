@@ -84,7 +84,16 @@ def _row(k0, d, V, vc, dt, h_div, h, tol, start, res, wall) -> dict:
         nominal_step=dt * min(1.0, res.period / SHORT_PHASE), n_steps=int(lengths.size),
         last_step_fraction=float(lengths[-1] / lengths[:-1].max()) if lengths.size > 1 else math.nan,
         coarse_period=res.coarse.period if res.coarse is not None else math.nan,
-        wall_s=round(wall, 1), message=res.message[:240])
+        drift_20=drift(res.history), wall_s=round(wall, 1), message=res.message[:240])
+
+
+def drift(history: np.ndarray, cycles: int = 20) -> float:
+    """The amplitude's change over the last ``cycles`` cycles of a run's history (since its
+    last restart; nan if shorter): how far a sequence still moves where it stops."""
+    if history is None or len(history) <= cycles:
+        return math.nan
+    a = history[:, 0] - history[:, 1]
+    return float(a[-1] - a[-1 - cycles])
 
 
 def _solve(k0: float, d: float, chain: list, tol: float, queue) -> None:
