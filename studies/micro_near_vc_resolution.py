@@ -167,7 +167,8 @@ def summary(frame: pd.DataFrame) -> str:
                 for i in range(1, len(s)):
                     a, b = s.iloc[i - 1], s.iloc[i]
                     ch = {q: b[q] - a[q] for q in QUANTITIES}
-                    lines.append(f"  along {axis:5s} at {fixed} = {value:g}: {a[axis]:g} -> {b[axis]:g}: "
+                    lines.append(f"  along {axis:5s} at {fixed} = {value:g}: {a[axis]:g} -> {b[axis]:g} "
+                                 f"(start {a.start} -> {b.start}): "
                                  + ", ".join(f"d{q} {ch[q]:+.2e}" for q in QUANTITIES)
                                  + f" (d amp / amp {ch['amplitude'] / b['amplitude']:+.1%}); errors {a.error:.1e} + "
                                  f"{b.error:.1e}; steps {a.n_steps} -> {b.n_steps}, step / nominal "
