@@ -28,7 +28,7 @@ docs/validation/micro_transition.md, "Which resolution fails near V^c".
     NUMBA_NUM_THREADS=1 python -m studies micro_near_vc_resolution --k0 0.01 --d 0.01 --tol 1e-5 \
         --runs 0.01:20,0.005:20,0.01:40                       # cold: 422 s, then two timeouts at 480 s
     NUMBA_NUM_THREADS=1 python -m studies micro_near_vc_resolution --k0 0.01 --d 0.01 --tol 1e-5 \
-        --max-seconds 2700 --runs 0.02:20,0.01:40@0,0.005:40@1,0.01:80@1   # one chain
+        --max-seconds 2700 --runs 0.02:20,0.01:40@0,0.005:40@1,0.01:80@1   # one chain: 27 min
     python -m studies micro_near_vc_resolution --summary
 """
 from __future__ import annotations
