@@ -45,13 +45,16 @@ def test_run_shows_progress_and_stops_keeping_the_samples(tmp_path):
 
 
 def test_sweep_stops_keeping_the_finished_rows(tmp_path):
-    # (near k_c a point takes 227 cycles, about half a second: 30 times the same point)
-    run = interrupt_after("rsf", ["sweep", *NEAR_KC[:2], "--V", ",".join(["0.078"] * 30), "--out", "s.csv"],
-                          cwd=tmp_path, wait_for=r"V [3-9]\d* of 30 .* s\]$")
+    # (near k_c a point takes 227 cycles, 0.1-0.5 s: 300 times the same point; interrupted
+    # at the first progress line past the second point, at about 1 s.  With 30 points the
+    # whole sweep took 3 s on an idle machine and its lines showed V 1, 10 and 29, none of
+    # which the pattern then waited for)
+    run = interrupt_after("rsf", ["sweep", *NEAR_KC[:2], "--V", ",".join(["0.078"] * 300), "--out", "s.csv"],
+                          cwd=tmp_path, wait_for=r"V ([3-9]|[1-9]\d+) of 300 .* s\]$")
     assert run.first_progress < FIRST_PROGRESS
     assert run.returncode == 130 and run.stop_time < STOP
     line = _one_line(run.after)
-    m = re.fullmatch(r"interrupted: (\d+) of 30 rows finished and written to s.csv", line)
+    m = re.fullmatch(r"interrupted: (\d+) of 300 rows finished and written to s.csv", line)
     assert m, line
     rows = pd.read_csv(tmp_path / "s.csv")
     assert len(rows) == int(m.group(1)) >= 2
