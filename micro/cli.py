@@ -82,6 +82,15 @@ def _write_csv(frame: pd.DataFrame, out: _outputs.Target | str | os.PathLike) ->
     _outputs.write(out, fill)
 
 
+def _keep_so_far(frame: pd.DataFrame, out: _outputs.Target, kept: list[str], what: str) -> None:
+    """A file holds every row computed so far: a later row that fails, or a kill, loses
+    nothing (standard output, a device or a FIFO take the rows once, at the end).  ``kept``
+    gets ``what`` (the message of a Ctrl-C)."""
+    if out.replaceable:
+        _write_csv(frame, out)
+        kept.append(f"{what} finished and written to {out}")
+
+
 def _bounded(value: float, name: str, low: float, high: float, *, open_low: bool = False) -> float:
     """``value`` finite and in [low, high] (``(low, high]`` with ``open_low``), or one error
     naming the option."""
@@ -397,10 +406,11 @@ def _options(args, models: list[Model]):
 _CRITICAL_FLAGS = {"V_min": "--V-min", "V_max": "--V-max", "rel_tol": "--rel-tol"}
 
 
-def _as_flags(text: str) -> str:
-    """``text`` with the parameters of :func:`micro.critical_velocity` named as their flags."""
-    for name, flag in _CRITICAL_FLAGS.items():
-        text = re.sub(rf"\b{name}\b", flag, text)
+def _as_flags(text: str, flags: dict[str, str] = _CRITICAL_FLAGS) -> str:
+    """``text`` with the parameters of an API call (by default :func:`micro.critical_velocity`'s)
+    named as their flags."""
+    for name, flag in flags.items():
+        text = re.sub(rf"\b{re.escape(name)}\b", flag, text)
     return text
 
 
@@ -449,11 +459,7 @@ def _run(args, kept: list[str]) -> int:
         method = "fp" if args.method == "fp" else cohort if args.method == "cohort" else Auto(cohort=cohort)
 
         def row_done(frame: pd.DataFrame) -> None:
-            # a file holds every row computed so far: a later row that fails, or a kill, loses
-            # nothing (standard output, a device or a FIFO take the rows once, at the end)
-            if out.replaceable:
-                _write_csv(frame, out)
-                kept.append(f"{len(frame)} of {len(velocities)} rows finished and written to {out}")
+            _keep_so_far(frame, out, kept, f"{len(frame)} of {len(velocities)} rows")
             last = frame.iloc[-1]
             print(f"{_progress(len(frame), len(velocities), time.perf_counter() - start)} V={last.V:g}: "
                   f"{last.regime} ({last.method}), sigma_max={last.sigma_max:.6f}, sigma_min={last.sigma_min:.6f}"
@@ -481,9 +487,8 @@ def _run(args, kept: list[str]) -> int:
             row = crit.to_dict()
             row["status"], row["message"] = _as_flags(row["status"]), _as_flags(row["message"])
             rows.append(row)
-            if out.replaceable:  # (every finished row is kept: a later one may take minutes, or fail)
-                _write_csv(pd.DataFrame(rows), out)
-                kept.append(f"{len(rows)} of {len(models)} rows finished and written to {out}")
+            # (every finished row is kept: a later one may take minutes, or fail)
+            _keep_so_far(pd.DataFrame(rows), out, kept, f"{len(rows)} of {len(models)} rows")
             print(f"{_progress(i + 1, len(models), time.perf_counter() - start)} k0={model.k0:g}: "
                   f"Vc={crit.Vc:.6g} ({row['status']})", file=sys.stderr)
         if not out.replaceable:
@@ -536,9 +541,7 @@ def _branch(args, model: Model, cohort: Cohort, out: _outputs.Target, kept: list
     """``micro branch``: the points written after each one; exit 0 when the walk reached
     --d-min with every point certified, 3 when it ended before (the reason on stderr)."""
     def point_done(frame: pd.DataFrame) -> None:
-        if out.replaceable:
-            _write_csv(frame, out)
-            kept.append(f"{len(frame)} points finished and written to {out}")
+        _keep_so_far(frame, out, kept, f"{len(frame)} points")
         last = frame.iloc[-1]
         print(f"[{len(frame)}, {time.perf_counter() - start:.0f} s] d={last.d:.4g} V={last.V:.6g}: "
               f"sigma_max={last.sigma_max:.6f}, amplitude={last.amplitude:.3g}, errors "
@@ -551,10 +554,7 @@ def _branch(args, model: Model, cohort: Cohort, out: _outputs.Target, kept: list
                            max_points=args.max_points, method=cohort, multipliers=args.multipliers,
                            on_point=point_done)
     except ValueError as exc:  # (name the flags the user typed)
-        text = str(exc).replace("model: ", "--dist: ", 1)
-        for name, flag in _BRANCH_FLAGS.items():
-            text = re.sub(rf"(?<![-\w]){re.escape(name)}\b", flag, text)
-        raise ValueError(text) from None
+        raise ValueError(_as_flags(str(exc).replace("model: ", "--dist: ", 1), _BRANCH_FLAGS)) from None
     if not out.replaceable or res.points.empty:
         _write_csv(res.points, out)
     print(f"wrote {len(res.points)} points to {out} in {time.perf_counter() - start:.1f} s; {res.reason}",
