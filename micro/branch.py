@@ -35,7 +35,7 @@ from . import _progress
 from .api import NEAR_VC, _check_model, _vc, check_cohort_work, stationary
 from .cohort import cycle_multipliers, not_applicable as cohort_not_applicable
 from .methods import Auto, Cohort
-from .params import Model
+from .params import Model, _number
 
 __all__ = ["Branch", "cycle_branch", "COLUMNS"]
 
@@ -82,10 +82,11 @@ class Branch:
 
 
 def _check_d(value, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0.0 < value < 1.0):
+    value = _number(name, value)
+    if not 0.0 < value < 1.0:
         raise ValueError(f"{name} must be in (0, 1) (d = 1 - V/V^c: 0 is V^c itself, 1 is V = 0); "
                          f"the branch of stick-slip cycles is continued below V^c only, got {value!r}")
-    return float(value)
+    return value
 
 
 def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method,
@@ -97,7 +98,7 @@ def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method,
         raise ValueError(f"model: cycle_branch computes its cycles by the cohort method, and {why}; other jump "
                          "laws have the Fokker-Planck time-stepping only: micro.sweep(model, V, method='fp')")
     d_min = _check_d(d_min, "d_min")
-    if not (isinstance(max_error, (int, float)) and not isinstance(max_error, bool) and 0.0 < max_error <= 1.0):
+    if not 0.0 < _number("max_error", max_error) <= 1.0:
         raise ValueError(f"max_error must be in (0, 1] (a fraction of the amplitude), got {max_error!r}")
     if not (isinstance(max_points, int) and not isinstance(max_points, bool) and max_points >= 2):
         raise ValueError(f"max_points must be an integer >= 2, got {max_points!r}")
@@ -111,7 +112,7 @@ def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method,
     Vc = _vc(model)
     if V_start is None:
         V_start = 0.2 * Vc
-    if isinstance(V_start, bool) or not isinstance(V_start, (int, float)) or not (0.0 < V_start < Vc):
+    if not 0.0 < _number("V_start", V_start) < Vc:
         raise ValueError(f"V_start must be in (0, V^c = {Vc:.6g}) (stick-slip; above V^c steady sliding is stable "
                          f"and there is no cycle to start from), got {V_start!r}")
     d_start = 1.0 - V_start / Vc
