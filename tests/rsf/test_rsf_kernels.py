@@ -3,8 +3,10 @@ stick and slip roots (first crossing, nothing skipped)."""
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 
-import numba
 import numpy as np
 import pytest
 
@@ -108,13 +110,26 @@ def test_law_eval_dispatch_rejects_unknown_code():
     assert all(math.isnan(x) for x in K.law_eval(1.0, np.array([99.0])))
 
 
-def test_root_kernels_compile_once_for_both_phases():
+_COMPILE_ONCE = """
+import math, numba, rsf
+from rsf import _kernels as K
+m = rsf.SpringSlider(k0=0.3)
+p = m.law.kernel_params
+K.stick_end(p, -0.01, 1.0, m.k0 * 0.1, m.Dc, 1e9, 0.0, math.nan)
+K.slip_end(p, 0.02, 1.0, m.K, m.Dc, m.K + m.law.weakening_bounds()[1], 1e-250 * m.Dc)
+K.decide(p, 1.0, m.K, 0.1, m.Dc)
+for kernel in (K.phase_fn, K.phase_dfn, K.brentq, K.first_root):
+    kinds = {sig[0] for sig in kernel.signatures}
+    assert kinds == {numba.int64}, (kernel.__name__, kinds)
+"""
+
+
+def test_root_kernels_compile_once_for_both_phases(tmp_path):
     # stick_end and slip_end hand phase_fn's kind as int64: a Python literal 0 or 1 made
-    # numba compile phase_fn, phase_dfn, brentq and first_root once per literal
-    m, p = _model(0.3)
-    K.stick_end(p, -0.01, 1.0, m.k0 * 0.1, m.Dc, 1e9, 0.0, math.nan)
-    K.slip_end(p, 0.02, 1.0, m.K, m.Dc, m.K + m.law.weakening_bounds()[1], 1e-250 * m.Dc)
-    K.decide(p, 1.0, m.K, 0.1, m.Dc)
-    for kernel in (K.phase_fn, K.phase_dfn, K.brentq, K.first_root):
-        kinds = {sig[0] for sig in kernel.signatures}
-        assert kinds == {numba.int64}, (kernel.__name__, kinds)
+    # numba compile phase_fn, phase_dfn, brentq and first_root once per literal.  In a fresh
+    # process with an empty numba cache, as on a first run: with the callers loaded from a
+    # warm cache (any run after the first) their callees are never typed in the process, and
+    # have no signatures to look at
+    done = subprocess.run([sys.executable, "-c", _COMPILE_ONCE], capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)})
+    assert done.returncode == 0, done.stderr
