@@ -24,7 +24,8 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from . import _cohort_newton, _renewal_kernels, cohort, nblock, renewal
+from . import _renewal_kernels, cohort, nblock, renewal
+from .cohort import newton as _cohort_newton
 from .params import Model
 
 __all__ = [
@@ -42,7 +43,7 @@ __all__ = [
 CohortState = cohort._Cohorts
 #: ``cycle_cohorts(..., start=NO_COARSE)``: no coarse transient first (``micro.cohort._NO_COARSE``).
 NO_COARSE = cohort._NO_COARSE
-#: The relative step of the Newton-Krylov's difference quotients (``micro._cohort_newton.FD_STEP``).
+#: The relative step of the Newton-Krylov's difference quotients (``micro.cohort.newton.FD_STEP``).
 NEWTON_FD_STEP = _cohort_newton.FD_STEP
 
 

@@ -7,7 +7,7 @@ error and its CPU time are kept in the row).  Its last state (just after a shock
 the map (``micro.study_hooks.carried_cycle``: one cycle from that state with its newborns'
 delta_R marginal replaced, at the run's step), whose fixed point is then solved by
 ``micro.study_hooks.newton_krylov`` (the Newton-Krylov that cycle_cohorts runs where its frozen-slip
-preconditioner grows: ``micro._cohort_newton.solve``, each system (I - J) d = G(x) - x by
+preconditioner grows: ``micro.cohort.newton.solve``, each system (I - J) d = G(x) - x by
 GMRES with Jacobian-vector products by forward differences of the map, the map taken
 again from each Newton step's state) to 1e-9 in the cycle's stresses.  With
 ``--consistent`` (the default) the step is then set to the one the fixed point's own

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import micro
-from micro import _cohort_kernels as CK
+from micro.cohort import kernels as CK
 from micro.cohort import _NO_COARSE, _one_cycle, _start, cycle_cohorts
 
 

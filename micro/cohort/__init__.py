@@ -47,12 +47,12 @@ import time
 import numpy as np
 import scipy.linalg
 
-from . import _cohort_kernels as CK
-from . import _cohort_newton
-from . import _progress
-from ._threads import blas_single_threaded
-from .params import KIND_EXPONENTIAL, Model
-from .results import CycleFixedPoint
+from . import kernels as CK
+from . import newton as _cohort_newton
+from .. import _progress
+from .._threads import blas_single_threaded
+from ..params import KIND_EXPONENTIAL, Model
+from ..results import CycleFixedPoint
 
 __all__ = ["cycle_cohorts"]
 
@@ -694,7 +694,7 @@ def _newton(step: float, dt: float, base: _Cohorts, tol: float, max_evals: int) 
     """The fixed point of the cycle map on the delta_R marginal after a shock
     (:func:`_carried_cycle` from the state ``base`` just after one, at the step ``step``
     and its graded-grid reference), by Newton-Krylov on the whole map
-    (:mod:`micro._cohort_newton`: GMRES with Jacobian-vector products by differences of
+    (:mod:`micro.cohort.newton`: GMRES with Jacobian-vector products by differences of
     the map, no frozen-slip linearisation), each judged column to NEWTON_TOL * ``tol``,
     in at most ``max_evals`` cycles.  The map does not apply (the evaluation is refused)
     where a cycle fails, leaves more than ANDERSON_UNJUMPED of the blocks unjumped or
@@ -728,7 +728,7 @@ def cycle_multipliers(cycle: CycleFixedPoint, k: int = 3) -> np.ndarray:
     Arnoldi's method (``scipy.sparse.linalg.eigs``, a Krylov space of ``MULTIPLIER_NCV``
     vectors, tolerance ``MULTIPLIER_TOL``) on the map's Jacobian, each product ``J v`` a
     forward difference of one cycle from the cycle's last state
-    (:func:`_carried_cycle`, the step of the Newton-Krylov, ``micro._cohort_newton.FD_STEP``
+    (:func:`_carried_cycle`, the step of the Newton-Krylov, ``micro.cohort.newton.FD_STEP``
     of the mass), on the nodes where the marginal holds more than 1e-12 of the mass (a
     perturbation of an empty node leaves the positive densities, and its quotient is not
     the Jacobian's).  The marginal is normalised by the map, so the mass is no direction
