@@ -37,6 +37,7 @@ map").  Inside the method it uses ``cycle_cohorts``' state and the hooks for stu
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 
 import numpy as np
@@ -44,6 +45,7 @@ import pandas as pd
 
 import micro
 import micro.cohort as C
+from micro.cohort import options as cohort_options
 from micro import study_hooks as H  # the cycle map, its Newton-Krylov, the step rule
 from benchmarks._harness import RESULTS, Stopwatch, merged, write_csv
 
@@ -156,9 +158,10 @@ def main() -> None:
     ap.add_argument("--tol", type=float, default=1e-8, help="cycle_cohorts' tol for its Newton-Krylov (stresses "
                     "to NEWTON_TOL times it)")
     ap.add_argument("--max-solves", type=int, default=6, help="solves at most in the search for the consistent step")
-    ap.add_argument("--floor", type=float, default=C.CELL_FLOOR, help="the cell floor micro.cohort.CELL_FLOOR")
+    ap.add_argument("--floor", type=float, default=cohort_options.DEFAULT.CELL_FLOOR,
+                    help="the cell floor, CELL_FLOOR of micro.cohort.options")
     a = ap.parse_args()
-    C.CELL_FLOOR = a.floor
+    cohort_options.DEFAULT = dataclasses.replace(cohort_options.DEFAULT, CELL_FLOOR=a.floor)
     model = micro.Model(k0=a.k0)
     V = a.fraction * micro.critical_velocity(model).Vc
     path = RESULTS / "micro_cohort_newton_krylov.csv"
