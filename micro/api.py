@@ -32,7 +32,7 @@ import pandas as pd
 
 from . import _progress, fp
 from .analytic import sigma_fast_limit
-from .cohort import GRADED_MAX, cycle_cohorts, not_applicable as cohort_not_applicable
+from .cohort import cycle_cohorts, not_applicable as cohort_not_applicable, options as cohort_options
 from .methods import COHORT_STEPS_MAX, FP, Auto, Cohort, Convergence, Method, Renewal, check_velocity, resolve
 from .params import Model, _number
 from .protocols import Drive
@@ -105,7 +105,7 @@ def cohort_steps_per_cycle(model: Model, V: float, dt: float) -> float:
     """About how many time steps one loading phase of the cohort method takes at V: the
     stress rises by the velocity weakening ``f_th - sigma_fast_limit`` at the rate
     ``k0 V``, in steps of up to ``GRADED_MAX dt`` (4 dt) away from the shocks."""
-    return (model.f_th - sigma_fast_limit(model)) / (model.k0 * V) / (GRADED_MAX * dt)
+    return (model.f_th - sigma_fast_limit(model)) / (model.k0 * V) / (cohort_options.DEFAULT.GRADED_MAX * dt)
 
 
 def check_cohort_work(model: Model, V: float, opts: Cohort) -> None:
@@ -133,7 +133,7 @@ def _cohort_row(model: Model, V: float, opts: Cohort, warn: bool,
         # user is not left waiting in silence; -v shows each cycle as it ends)
         log.warning("micro.stationary(k0=%g, V=%g): a slow drive for the cohort method: each cycle loads for "
                     "about %.2g time units, %.2g steps of dt = %g, and 10-20 cycles are needed; this may take "
-                    "%s", model.k0, V, steps * GRADED_MAX * opts.dt, steps, opts.dt,
+                    "%s", model.k0, V, steps * cohort_options.DEFAULT.GRADED_MAX * opts.dt, steps, opts.dt,
                     "hours" if steps > 1e7 else "minutes")
     res = cycle_cohorts(model, V, dt=opts.dt, h=h, tol=opts.tol, max_iter=opts.max_iter, start=start)
     if not res.applicable:

@@ -24,7 +24,8 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from . import _cohort_newton, _renewal_kernels, cohort, nblock, renewal
+from . import _renewal_kernels, nblock, renewal
+from .cohort import cycle as _cycle, estimate as _estimate, options as _options, solver as _solver, state as _state
 from .params import Model
 
 __all__ = [
@@ -37,100 +38,102 @@ __all__ = [
 
 # --- cohort method ---------------------------------------------------------------------
 
-#: The cohort method's state class (``micro.cohort._Cohorts``); a study may subclass it to
+#: The cohort method's state class (``micro.cohort.state._Cohorts``); a study may subclass it to
 #: observe a cycle (its methods are the ones ``one_cycle`` calls).
-CohortState = cohort._Cohorts
-#: ``cycle_cohorts(..., start=NO_COARSE)``: no coarse transient first (``micro.cohort._NO_COARSE``).
-NO_COARSE = cohort._NO_COARSE
-#: The relative step of the Newton-Krylov's difference quotients (``micro._cohort_newton.FD_STEP``).
-NEWTON_FD_STEP = _cohort_newton.FD_STEP
+CohortState = _state._Cohorts
+#: ``cycle_cohorts(..., start=NO_COARSE)``: no coarse transient first (``micro.cohort.solver._NO_COARSE``).
+NO_COARSE = _solver._NO_COARSE
+#: The relative step of the Newton-Krylov's difference quotients (``FD_STEP`` of
+#: ``micro.cohort.options.DEFAULT``).
+NEWTON_FD_STEP = _options.DEFAULT.FD_STEP
 
 
-def start_state(model: Model, V: float, h: float, p=None, dep=None) -> cohort._Cohorts:
-    """For studies: the state after a total shock (``micro.cohort._start``)."""
-    return cohort._start(model, V, h, p, dep)
+def start_state(model: Model, V: float, h: float, p=None, dep=None) -> _state._Cohorts:
+    """For studies: the state after a total shock (``micro.cohort.state._start``)."""
+    return _state._start(model, V, h, p, dep)
 
 
-def continued(start, model: Model, V: float, h: float) -> cohort._Cohorts | None:
+def continued(start, model: Model, V: float, h: float) -> _state._Cohorts | None:
     """For studies: the whole state of a result ``start`` moved to ``V`` with cells ``h``,
-    or None (``micro.cohort._continued``)."""
-    return cohort._continued(start, model, V, h)
+    or None (``micro.cohort.state._continued``)."""
+    return _state._continued(start, model, V, h)
 
 
-def one_cycle(state: cohort._Cohorts, step: float) -> dict:
+def one_cycle(state: _state._Cohorts, step: float) -> dict:
     """For studies: one cycle of the cohort map from ``state`` (changed in place) with
-    loading steps ``step``; its extrema, period and unjumped fraction (``micro.cohort._one_cycle``)."""
-    return cohort._one_cycle(state, step)
+    loading steps ``step``; its extrema, period and unjumped fraction (``micro.cohort.cycle._one_cycle``)."""
+    return _cycle._one_cycle(state, step)
 
 
 def phase_step(period: float, dt: float) -> float:
     """For studies: the loading step a run takes for a cycle of ``period`` at ``dt``
-    (``micro.cohort._phase_step``)."""
-    return cohort._phase_step(period, dt)
+    (``micro.cohort.cycle._phase_step``)."""
+    return _cycle._phase_step(period, dt)
 
 
 def step_off(period: float, step: float, dt: float) -> bool:
     """For studies: whether ``step`` is no longer the step for ``period`` (a run starts its
-    sequence again; ``micro.cohort._step_off``)."""
-    return cohort._step_off(period, step, dt)
+    sequence again; ``micro.cohort.cycle._step_off``)."""
+    return _cycle._step_off(period, step, dt)
 
 
 def relaxation_multiplier(model: Model, period: float) -> float:
-    """For studies: the slowest relaxation's multiplier over one period (``micro.cohort._relaxation_multiplier``)."""
-    return cohort._relaxation_multiplier(model, period)
+    """For studies: the slowest relaxation's multiplier over one period
+    (``micro.cohort.estimate._relaxation_multiplier``)."""
+    return _estimate._relaxation_multiplier(model, period)
 
 
 def error_estimate(a: np.ndarray, tol: float, slowest: float = 0.0):
-    """For studies: the run's error rule from its cycles' values ``a`` (``micro.cohort._estimate``):
+    """For studies: the run's error rule from its cycles' values ``a`` (``micro.cohort.estimate._estimate``):
     errors, how each was found, the best values, and the extrapolated ones."""
-    return cohort._estimate(a, tol, slowest)
+    return _estimate._estimate(a, tol, slowest)
 
 
 def state_tail(a: np.ndarray, moves: np.ndarray, steps: np.ndarray, slowest: float = 0.0) -> tuple[float, float]:
-    """For studies: the bound from the state's move (``micro.cohort._state_tail``)."""
-    return cohort._state_tail(a, moves, steps, slowest)
+    """For studies: the bound from the state's move (``micro.cohort.estimate._state_tail``)."""
+    return _estimate._state_tail(a, moves, steps, slowest)
 
 
 def product_cycle(model: Model, V: float, h: float, step: float, ref: float, x: np.ndarray):
-    """For studies: the cycle map on the normalised delta_R marginal ``x`` (``micro.cohort._product_cycle``)."""
-    return cohort._product_cycle(model, V, h, step, ref, x)
+    """For studies: the cycle map on the normalised delta_R marginal ``x`` (``micro.cohort.cycle._product_cycle``)."""
+    return _cycle._product_cycle(model, V, h, step, ref, x)
 
 
-def carried_cycle(base: cohort._Cohorts, step: float, ref: float, v: np.ndarray):
-    """For studies: one cycle from ``base`` with its cells' masses ``v`` (``micro.cohort._carried_cycle``)."""
-    return cohort._carried_cycle(base, step, ref, v)
+def carried_cycle(base: _state._Cohorts, step: float, ref: float, v: np.ndarray):
+    """For studies: one cycle from ``base`` with its cells' masses ``v`` (``micro.cohort.cycle._carried_cycle``)."""
+    return _cycle._carried_cycle(base, step, ref, v)
 
 
 def support(x: np.ndarray, g: np.ndarray) -> np.ndarray:
-    """For studies: the cells the cycle map acts on (``micro.cohort._support``)."""
-    return cohort._support(x, g)
+    """For studies: the cells the cycle map acts on (``micro.cohort.solver._support``)."""
+    return _solver._support(x, g)
 
 
-def map_multipliers(base: cohort._Cohorts, step: float, ref: float, x: np.ndarray, k: int = 3,
+def map_multipliers(base: _state._Cohorts, step: float, ref: float, x: np.ndarray, k: int = 3,
                     ncv: int = 25, tol: float = 1e-4) -> tuple[np.ndarray, int]:
     """For studies: the ``k`` largest multipliers of the cycle map from ``base`` at the
-    marginal ``x``, and the cycles taken (``micro.cohort._map_multipliers``, which
+    marginal ``x``, and the cycles taken (``micro.cohort.solver._map_multipliers``, which
     :func:`micro.cohort.cycle_multipliers` uses with a smaller Krylov space)."""
-    return cohort._map_multipliers(base, step, ref, x, k, ncv, tol)
+    return _solver._map_multipliers(base, step, ref, x, k, ncv, tol)
 
 
-def newton_krylov(step: float, dt: float, base: cohort._Cohorts, tol: float, max_evals: int):
+def newton_krylov(step: float, dt: float, base: _state._Cohorts, tol: float, max_evals: int):
     """For studies: the Newton-Krylov fixed point of the whole cycle map that
-    ``cycle_cohorts`` falls back on (``micro.cohort._newton``)."""
-    return cohort._newton(step, dt, base, tol, max_evals)
+    ``cycle_cohorts`` falls back on (``micro.cohort.solver._newton``)."""
+    return _solver._newton(step, dt, base, tol, max_evals)
 
 
 @contextlib.contextmanager
 def gauss_rule(x: np.ndarray, w: np.ndarray) -> Iterator[None]:
     """For studies: the cohort method's Gauss nodes ``x`` and weights ``w`` on [0, 1]
-    (``micro.cohort._GX``, ``_GW``; two-point Gauss-Legendre by default) replaced inside
+    (``micro.cohort.state._GX``, ``_GW``; two-point Gauss-Legendre by default) replaced inside
     the ``with`` block, restored after it."""
-    old = cohort._GX, cohort._GW
-    cohort._GX, cohort._GW = np.asarray(x, float), np.asarray(w, float)
+    old = _state._GX, _state._GW
+    _state._GX, _state._GW = np.asarray(x, float), np.asarray(w, float)
     try:
         yield
     finally:
-        cohort._GX, cohort._GW = old
+        _state._GX, _state._GW = old
 
 
 # --- renewal chain ---------------------------------------------------------------------

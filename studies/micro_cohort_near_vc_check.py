@@ -4,7 +4,7 @@ its cell is refined, and what moves it?
 Each run is one ``micro.cohort.cycle_cohorts`` call at dt = 0.02 and the cell
 ``kappa zbar / h_div``, either with micro's default stopping (tol = 2e-5, ``--cycles 0``)
 or forced to iterate ``--cycles`` plain cycles (tol = 1e-10: a run that cannot stop
-early), with the cell floor ``micro.cohort.CELL_FLOOR`` (cells with less surviving mass
+early), with the cell floor ``CELL_FLOOR`` of ``micro.cohort.options`` (cells with less surviving mass
 are dropped) set to ``--floor``.  Prints sigma_max, the period, the cycles run, whether
 the result is certified and its message; appends a row to
 benchmarks/results/micro_cohort_near_vc_check.csv.
@@ -24,11 +24,13 @@ Private names: ``cycle_cohorts`` (for ``max_iter`` and the history) and ``CELL_F
 from __future__ import annotations
 
 import argparse
+import dataclasses
 
 import pandas as pd
 
 import micro
-import micro.cohort as C  # private: CELL_FLOOR and cycle_cohorts' history (see above)
+import micro.cohort as C  # cycle_cohorts' history (see above)
+from micro.cohort import options as cohort_options  # CELL_FLOOR
 from benchmarks._harness import RESULTS, Stopwatch, merged, write_csv
 
 
@@ -37,11 +39,11 @@ def main() -> None:
     ap.add_argument("--h-div", type=float, default=20.0)
     ap.add_argument("--dt", type=float, default=0.02)
     ap.add_argument("--cycles", type=int, default=0, help="plain cycles to force (0: default stopping)")
-    ap.add_argument("--floor", type=float, default=C.CELL_FLOOR)
+    ap.add_argument("--floor", type=float, default=cohort_options.DEFAULT.CELL_FLOOR)
     ap.add_argument("--k0", type=float, default=0.01)
     ap.add_argument("--fraction", type=float, default=0.9)
     a = ap.parse_args()
-    C.CELL_FLOOR = a.floor
+    cohort_options.DEFAULT = dataclasses.replace(cohort_options.DEFAULT, CELL_FLOOR=a.floor)
     model = micro.Model(k0=a.k0)
     V = a.fraction * micro.critical_velocity(model).Vc
     h = model.kappa * model.zbar / a.h_div

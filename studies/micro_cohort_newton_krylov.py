@@ -7,7 +7,7 @@ error and its CPU time are kept in the row).  Its last state (just after a shock
 the map (``micro.study_hooks.carried_cycle``: one cycle from that state with its newborns'
 delta_R marginal replaced, at the run's step), whose fixed point is then solved by
 ``micro.study_hooks.newton_krylov`` (the Newton-Krylov that cycle_cohorts runs where its frozen-slip
-preconditioner grows: ``micro._cohort_newton.solve``, each system (I - J) d = G(x) - x by
+preconditioner grows: ``micro.cohort.newton.solve``, each system (I - J) d = G(x) - x by
 GMRES with Jacobian-vector products by forward differences of the map, the map taken
 again from each Newton step's state) to 1e-9 in the cycle's stresses.  With
 ``--consistent`` (the default) the step is then set to the one the fixed point's own
@@ -37,6 +37,7 @@ map").  Inside the method it uses ``cycle_cohorts``' state and the hooks for stu
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 
 import numpy as np
@@ -44,6 +45,7 @@ import pandas as pd
 
 import micro
 import micro.cohort as C
+from micro.cohort import options as cohort_options
 from micro import study_hooks as H  # the cycle map, its Newton-Krylov, the step rule
 from benchmarks._harness import RESULTS, Stopwatch, merged, write_csv
 
@@ -156,9 +158,10 @@ def main() -> None:
     ap.add_argument("--tol", type=float, default=1e-8, help="cycle_cohorts' tol for its Newton-Krylov (stresses "
                     "to NEWTON_TOL times it)")
     ap.add_argument("--max-solves", type=int, default=6, help="solves at most in the search for the consistent step")
-    ap.add_argument("--floor", type=float, default=C.CELL_FLOOR, help="the cell floor micro.cohort.CELL_FLOOR")
+    ap.add_argument("--floor", type=float, default=cohort_options.DEFAULT.CELL_FLOOR,
+                    help="the cell floor, CELL_FLOOR of micro.cohort.options")
     a = ap.parse_args()
-    C.CELL_FLOOR = a.floor
+    cohort_options.DEFAULT = dataclasses.replace(cohort_options.DEFAULT, CELL_FLOOR=a.floor)
     model = micro.Model(k0=a.k0)
     V = a.fraction * micro.critical_velocity(model).Vc
     path = RESULTS / "micro_cohort_newton_krylov.csv"

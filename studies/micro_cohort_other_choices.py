@@ -2,7 +2,7 @@
 at a time at a fixed (dt, h): does any of them move the cycle?
 
 The refinement studies move ``dt`` and the cell ``h`` (together or apart).  The method has
-other choices, module constants of ``micro.cohort``, whose effect should vanish or be
+other choices, fields of ``micro.cohort.options.CohortOptions``, whose effect should vanish or be
 nil: the grading of long loading phases (``GRADED_MAX``, ``GRADED_SLACK``), the step count
 of short ones (``SHORT_PHASE``), the tolerance of the shock's start (``FOLD_TOL``), the mass
 below which a cell is dropped (``CELL_FLOOR``), the replay of the loading phase's end for
@@ -28,7 +28,8 @@ import numpy as np
 
 import micro
 from benchmarks._harness import RESULTS, Stopwatch, warm_up, write_csv
-from micro import cohort, study_hooks
+from micro import study_hooks
+from micro.cohort import options as cohort_options
 
 VARIANTS = (("GRADED_MAX", 1.0), ("SHORT_PHASE", 1.0), ("FOLD_TOL", 1e-10), ("CELL_FLOOR", 1e-16),
             ("PEAK_CREEP", 0.0), ("AGE", 0.45), ("AGE", 0.55), ("GRADED_SLACK", 0.05))
@@ -63,12 +64,8 @@ def main() -> None:
 
     run("baseline")
     for name, value in VARIANTS:
-        old = getattr(cohort, name)
-        setattr(cohort, name, value)
-        try:
+        with cohort_options.override(**{name: value}):
             run(f"{name} = {value:g}")
-        finally:
-            setattr(cohort, name, old)
     x, w = np.polynomial.legendre.leggauss(4)
     with study_hooks.gauss_rule(0.5 * x + 0.5, 0.5 * w):
         run("Gauss-Legendre 4")

@@ -36,6 +36,8 @@ import pandas as pd
 
 import micro
 from micro import cohort as C
+from micro.cohort import options as cohort_options
+from micro.cohort.estimate import COLUMNS, JUDGED, WINDOW
 from micro import study_hooks as H
 
 from benchmarks._harness import RESULTS, Stopwatch, warm_up, write_csv
@@ -48,7 +50,8 @@ def record(k0: float, frac: float, dt: float, tol: float, cycles: int) -> pd.Dat
     model = micro.Model(k0=k0)
     V = frac * micro.critical_velocity(model).Vc
     h = 5.0 * model.kappa * model.zbar * dt
-    coarse = C.cycle_cohorts(model, V, dt=2 * dt, h=2 * h, tol=max(C.COARSE_TOL * tol, C.COARSE_FLOOR),
+    opt = cohort_options.DEFAULT
+    coarse = C.cycle_cohorts(model, V, dt=2 * dt, h=2 * h, tol=max(opt.COARSE_TOL * tol, opt.COARSE_FLOOR),
                              max_iter=300, start=H.NO_COARSE)
     st = H.continued(coarse, model, V, h)
     step = H.phase_step(coarse.period, dt)
@@ -61,7 +64,7 @@ def record(k0: float, frac: float, dt: float, tol: float, cycles: int) -> pd.Dat
             continue
         rows.append(dict(k0=k0, V_over_Vc=frac, dt=dt, h=h, cycle=len(rows), period=out["period"],
                          steps=len(out["steps"]), move=float(np.abs(out["marginal"] - previous).sum()),
-                         unjumped=out["unjumped"], **{c: out[c] for c in C.COLUMNS if c != "period"}))
+                         unjumped=out["unjumped"], **{c: out[c] for c in COLUMNS if c != "period"}))
         previous = out["marginal"]
         if len(rows) % 20 == 0:
             print(f"  k0 = {k0:g}, {frac:g} V^c: cycle {len(rows)}, sigma_max {out['sigma_max']:.9f}, "
@@ -74,7 +77,7 @@ def replay(seq: pd.DataFrame, tol: float) -> None:
     seq = seq.sort_values("cycle")
     k0, frac = float(seq.k0.iloc[0]), float(seq.V_over_Vc.iloc[0])
     model = micro.Model(k0=k0)
-    a = seq[list(C.COLUMNS)].to_numpy()
+    a = seq[list(COLUMNS)].to_numpy()
     moves = seq.move.to_numpy().copy()
     moves[0] = np.nan
     steps = seq.steps.to_numpy()
@@ -82,12 +85,12 @@ def replay(seq: pd.DataFrame, tol: float) -> None:
     r = (moves[-1] / moves[-11]) ** 0.1
     last = a[-1] - a[-2]
     limit = a[-1] + last * r / (1.0 - r)
-    judged = list(C.JUDGED)
+    judged = list(JUDGED)
     print(f"k0 = {k0:g}, {frac:g} V^c, dt = {seq.dt.iloc[0]:g}: {len(a)} cycles, state contraction {r:.4f}, "
           f"limit sigma_max {limit[0]:.8f} sigma_min {limit[1]:.8f} (its tail {np.abs(last * r / (1 - r))[judged].max():.1e}); "
           f"kinks at cycles {kinks.tolist()}")
     passed, stopped = {"before": 0, "now": 0}, set()
-    for n in range(C.WINDOW, len(a) + 1):
+    for n in range(WINDOW, len(a) + 1):
         slowest = H.relaxation_multiplier(model, a[n - 1, 2])
         errors, how, best, _ = H.error_estimate(a[:n], tol, slowest)
         tail, m = H.state_tail(a[:n], moves[:n], steps[:n], slowest)

@@ -13,7 +13,7 @@ the one before), and then the whole list is one chain in one process, stopped af
 ``--max-seconds`` in all.  Each row keeps the extrema, the period, the fixed point's
 error and how it was certified (``path``: plain cycles, Anderson, Newton-Krylov, or not
 certified), the shocks' unjumped fraction (Anderson's acceleration needs it below
-``micro.cohort.ANDERSON_UNJUMPED``), the loading phase's step (``phase_step``: close to
+``ANDERSON_UNJUMPED`` of ``micro.cohort.options``), the loading phase's step (``phase_step``: close to
 V^c it is ``dt T / SHORT_PHASE`` for the T at which it was last set, kept while within a
 quarter of that; ``nominal_step`` is the one for the cycle's own T) and its number of
 steps in the last cycle (``n_steps``, the integer count: a candidate cause of a
@@ -43,7 +43,7 @@ import numpy as np
 import pandas as pd
 
 import micro
-from micro.cohort import SHORT_PHASE, cycle_cohorts
+from micro.cohort import cycle_cohorts, options as cohort_options
 
 from benchmarks._harness import RESULTS, write_csv
 
@@ -81,7 +81,7 @@ def _row(k0, d, V, vc, dt, h_div, h, tol, start, res, wall) -> dict:
         sigma_after=res.sigma_after, period=res.period, error=res.error, converged=bool(res.converged),
         certified=bool(res.converged and math.isfinite(res.error)), path=path_of(res), iterations=res.iterations,
         accelerated=bool(res.accelerated), unjumped=res.unjumped, phase_step=step,
-        nominal_step=dt * min(1.0, res.period / SHORT_PHASE), n_steps=int(lengths.size),
+        nominal_step=dt * min(1.0, res.period / cohort_options.DEFAULT.SHORT_PHASE), n_steps=int(lengths.size),
         last_step_fraction=float(lengths[-1] / lengths[:-1].max()) if lengths.size > 1 else math.nan,
         coarse_period=res.coarse.period if res.coarse is not None else math.nan,
         drift_20=drift(res.history), wall_s=round(wall, 1), message=res.message[:240])

@@ -83,6 +83,7 @@ from scipy import optimize
 
 import micro
 from micro import cohort as C
+from micro.cohort import options as cohort_options
 from micro import study_hooks as H  # the state class and the cycle map, for studies
 
 from benchmarks._harness import RESULTS, Stopwatch, warm_up, write_csv
@@ -193,7 +194,7 @@ class Probe(H.CohortState):
             Xp = optimize.brentq(lambda x: self.closure(x)[1], Xi[j], Xi[j + 1], xtol=1e-300, rtol=1e-12)
             Hp = self.closure(Xp)[0]
         # the fold's distance in time: a loading step of FOLD_TOL * step from here
-        et = C.FOLD_TOL * self.dt
+        et = cohort_options.DEFAULT.FOLD_TOL * self.dt
         c1 = delta_star = b_pred = math.nan
         if math.isfinite(Xm):
             H0m = self.closure(Xm)[0]

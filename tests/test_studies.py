@@ -99,12 +99,12 @@ def test_studies_are_not_a_package_of_the_distribution():
 
 
 def test_gauss_rule_hook_replaces_and_restores_the_rule():
-    from micro import cohort
-    before = cohort._GX.copy(), cohort._GW.copy()
+    from micro.cohort import state
+    before = state._GX.copy(), state._GW.copy()
     x, w = np.polynomial.legendre.leggauss(4)
     with H.gauss_rule(0.5 * x + 0.5, 0.5 * w):
-        assert cohort._GX.size == 4 and cohort._GW.sum() == pytest.approx(1.0)
-    assert np.array_equal(cohort._GX, before[0]) and np.array_equal(cohort._GW, before[1])
+        assert state._GX.size == 4 and state._GW.sum() == pytest.approx(1.0)
+    assert np.array_equal(state._GX, before[0]) and np.array_equal(state._GW, before[1])
 
 
 def test_chain_on_grid_hook_gives_the_steady_stress():

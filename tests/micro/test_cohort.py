@@ -7,6 +7,7 @@ sigma_max at the same point.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -14,8 +15,11 @@ import numpy as np
 import pytest
 
 import micro
-from micro import _cohort_kernels as CK
-from micro.cohort import _NO_COARSE, _one_cycle, _start, cycle_cohorts
+from micro.cohort import kernels as CK
+from micro.cohort import cycle_cohorts
+from micro.cohort.cycle import _one_cycle
+from micro.cohort.solver import _NO_COARSE
+from micro.cohort.state import _start
 
 
 def test_state_after_a_total_shock_has_branching_ratio_one_minus_k0_over_kappa():
@@ -63,27 +67,49 @@ def test_a_long_loading_phase_takes_longer_steps_in_its_middle(monkeypatch):
     # k0 = 0.01, 0.1 V^c: a loading phase of about 9 / gamma.  Steps dt within 1 / gamma of
     # either end, up to 4 dt between: from the same state, the graded loading phase takes
     # 149 closure set-ups where uniform steps take 260, and its extrema move by < 1e-6
-    from micro import cohort
+    from micro.cohort import cycle, options, state
     gamma = 0.9
-    assert cohort._step_length(0.0, 10.0, 0.01, gamma) == 0.01
-    assert cohort._step_length(3.0, 10.0, 0.01, gamma) == pytest.approx(0.027)
-    assert cohort._step_length(5.0, 10.0, 0.01, gamma) == 0.04
-    assert cohort._step_length(9.5, 10.0, 0.01, gamma) == 0.01
-    assert cohort._step_length(5.0, 0.0, 0.01, gamma) == 0.01  # no reference phase yet
+    assert cycle._step_length(0.0, 10.0, 0.01, gamma) == 0.01
+    assert cycle._step_length(3.0, 10.0, 0.01, gamma) == pytest.approx(0.027)
+    assert cycle._step_length(5.0, 10.0, 0.01, gamma) == 0.04
+    assert cycle._step_length(9.5, 10.0, 0.01, gamma) == 0.01
+    assert cycle._step_length(5.0, 0.0, 0.01, gamma) == 0.01  # no reference phase yet
     model = micro.Model(k0=0.01)
     V = 0.1 * micro.critical_velocity(model).Vc
     st = _start(model, V, model.kappa * model.zbar / 5.0, None)
     assert _one_cycle(st, 0.04)["ok"] and st.period_ref > 8.0 / model.gamma
     calls = []
-    prepare = cohort._Cohorts.prepare
-    monkeypatch.setattr(cohort._Cohorts, "prepare", lambda self, dt: calls.append(dt) or prepare(self, dt))
+    prepare = state._Cohorts.prepare
+    monkeypatch.setattr(state._Cohorts, "prepare", lambda self, dt: calls.append(dt) or prepare(self, dt))
     graded = _one_cycle(st.copy(), 0.04)
     n_graded = len(calls)
-    monkeypatch.setattr(cohort, "GRADED_MAX", 1.0)
+    monkeypatch.setattr(options, "DEFAULT", dataclasses.replace(options.DEFAULT, GRADED_MAX=1.0))
     uniform = _one_cycle(st.copy(), 0.04)
     assert n_graded < 0.65 * (len(calls) - n_graded)
     for name in ("sigma_max", "sigma_min", "sigma_after"):
         assert graded[name] == pytest.approx(uniform[name], abs=2e-6)
+
+
+def test_the_tuning_constants_are_one_frozen_options_object_that_checks_itself():
+    """The cohort method's constants are the fields of one frozen CohortOptions; a value out
+    of range fails naming the field; the runs read ``options.DEFAULT`` when they need one
+    (so ``override`` changes the step rule inside its block, and restores it after)."""
+    from micro.cohort import cycle, options
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        options.DEFAULT.GRADED_MAX = 1.0
+    for field, value, allowed in (("GRADED_MAX", 0.5, "a number >= 1"), ("MAX_CELLS", 1.5, "an integer >= 1"),
+                                  ("AGE", 1.5, r"a number in \[0, 1\]"), ("CELL_FLOOR", 0.0, "a finite number > 0"),
+                                  ("AITKEN_MAX_RATIO", 1.0, r"a number in \(0, 1\)"),
+                                  ("ANDERSON_BACKTRACKS", -1, "an integer >= 0"), ("BAND_ABOVE", 16, "below")):
+        with pytest.raises(ValueError, match=f"CohortOptions {field} must be {allowed}"):
+            dataclasses.replace(options.DEFAULT, **{field: value})
+    assert dataclasses.replace(options.DEFAULT, GRADED_MAX=math.inf, PEAK_CREEP=0.0).GRADED_MAX == math.inf
+    default = options.DEFAULT
+    assert cycle._phase_step(0.1, 0.01) == pytest.approx(0.01 * 0.1 / default.SHORT_PHASE)
+    with options.override(SHORT_PHASE=0.25) as changed:
+        assert options.DEFAULT is changed and changed.SHORT_PHASE == 0.25 and default.SHORT_PHASE == 0.5
+        assert cycle._phase_step(0.1, 0.01) == pytest.approx(0.01 * 0.1 / 0.25)
+    assert options.DEFAULT is default and cycle._phase_step(0.1, 0.01) == pytest.approx(0.01 * 0.1 / 0.5)
 
 
 def test_the_cycles_trace_is_its_steps_stresses():
@@ -115,11 +141,11 @@ def test_step_roots_are_the_first_sign_change_of_the_closure_even_next_to_a_fold
     some roots are nearly double: the root finder steps to a parabola's zero there (Newton
     from the left only halved the distance per evaluation) and stops at H's round-off (it
     had bisected noise)."""
-    from micro import cohort
+    from micro.cohort import state
     model = micro.Model(k0=1e-3)
     V = 0.85 * micro.critical_velocity(model).Vc
     st = _start(model, V, model.kappa * model.zbar / 5.0, None)
-    root = cohort._Cohorts.root
+    root = state._Cohorts.root
     slopes = []
 
     def checked_root(self, below=0.0):
@@ -133,7 +159,7 @@ def test_step_roots_are_the_first_sign_change_of_the_closure_even_next_to_a_fold
             slopes.append(abs(dH))
         return x, status
 
-    monkeypatch.setattr(cohort._Cohorts, "root", checked_root)
+    monkeypatch.setattr(state._Cohorts, "root", checked_root)
     for _ in range(2):
         assert _one_cycle(st, 0.004)["ok"]
     # many roots, some next to a fold (slope below a twentieth of k0 / kappa, the state after a shock)
@@ -147,11 +173,11 @@ def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
     Newton in a bracket a hundredth wide: the same slips and the same folds as Newton from
     0 and plain bisection (at k0 = 1e-4 the shock's closure is flat, dH = -1e-4, and
     lands on exactly 0: a first version returned a bisection point there, 1.3 off)."""
-    from micro import cohort
+    from micro.cohort import state
     model = micro.Model(k0=k0)
     V = frac * micro.critical_velocity(model).Vc
     st = _start(model, V, model.kappa * model.zbar / 5.0, None)
-    root, shock_root = cohort._Cohorts.root, cohort._Cohorts.shock_root
+    root, shock_root = state._Cohorts.root, state._Cohorts.shock_root
     seen = {"warm": 0, "shocks": 0}
 
     def checked_root(self, below=0.0):
@@ -177,8 +203,8 @@ def test_warm_started_roots_are_the_cold_started_ones(monkeypatch, k0, frac):
         seen["shocks"] += 1
         return x
 
-    monkeypatch.setattr(cohort._Cohorts, "root", checked_root)
-    monkeypatch.setattr(cohort._Cohorts, "shock_root", checked_shock_root)
+    monkeypatch.setattr(state._Cohorts, "root", checked_root)
+    monkeypatch.setattr(state._Cohorts, "shock_root", checked_shock_root)
     for _ in range(2):
         assert _one_cycle(st, 0.04 if frac < 0.9 else 0.004)["ok"]
     assert seen["warm"] > 20 and seen["shocks"] == 2
@@ -251,13 +277,13 @@ def test_a_short_loading_phase_gets_its_steps_from_the_cycle_not_from_the_transi
     # transient cut it to: it used to stay at 0.65 of that, so the resolution depended on
     # the path to the cycle, not on dt.  With the coarse transient first, the fine run
     # takes the coarse cycle's phase; without it, the run lengthens the step it had cut
-    from micro import cohort
+    from micro.cohort import options
     model = micro.Model(k0=0.3)
     dt = 0.02
     res = cycle_cohorts(model, 0.95 * micro.critical_velocity(model).Vc, dt=dt, h=model.kappa * model.zbar / 10,
                         tol=1e-3, start=None if coarse else _NO_COARSE)
-    assert res.converged and res.period < cohort.SHORT_PHASE
-    assert res.state.dt == pytest.approx(dt * res.period / cohort.SHORT_PHASE, rel=0.25)
+    assert res.converged and res.period < options.DEFAULT.SHORT_PHASE
+    assert res.state.dt == pytest.approx(dt * res.period / options.DEFAULT.SHORT_PHASE, rel=0.25)
 
 
 def test_a_shock_keeps_the_mean_lag_at_zero():
@@ -426,7 +452,7 @@ def test_each_quantity_is_judged_on_its_own():
     # bounds the true distance to the limit once the slow mode shows; column 1 alternates
     # below tol / STILL: noise, not a drift; column 2: one mode, extrapolated exactly; column 3
     # jumps (a change of the step count): not contracting, a large error
-    from micro.cohort import _estimate
+    from micro.cohort.estimate import _estimate
     n = np.arange(13)
     a = np.zeros((13, 4))
     a[:, 0] = 0.9 - 1e-4 * 0.97 ** n - 3e-4 * 0.6 ** n
@@ -449,7 +475,7 @@ def test_an_extrapolation_that_runs_off_is_not_reported():
     reported it (micro_cohort_other_choices.py, SHORT_PHASE = 1).  A ratio above 0.999 is
     judged as a drift: the last cycle, with the error of a thousand such steps; a clean
     geometric tail is still extrapolated."""
-    from micro.cohort import _estimate
+    from micro.cohort.estimate import _estimate
     d = np.array([-2.51e-8, -2.50e-8, -2.49e-8, -2.49e-8 * (1 - 4e-8)])
     period = 0.2097144864 + np.concatenate([[0.0], np.cumsum(d)])
     errors, how, best, _ = _estimate(period[:, None], 1e-6)
@@ -466,7 +492,8 @@ def test_tiny_steps_along_a_slow_mode_are_not_convergence():
     (docs/validation/micro_cohort.md section 5).  With the model's slowest multiplier there
     (a lone block's relaxation over the period, 0.9992) the same steps leave m / (1 - m)
     times themselves: not within tol; a fast map keeps the old factor five."""
-    from micro.cohort import _estimate, _relaxation_multiplier, STILL
+    from micro.cohort.estimate import _estimate, _relaxation_multiplier
+    from micro.cohort.options import DEFAULT
     model = micro.Model(k0=0.001)
     m = _relaxation_multiplier(model, 0.0088)
     assert m == pytest.approx(0.9992, abs=1e-4)
@@ -476,7 +503,7 @@ def test_tiny_steps_along_a_slow_mode_are_not_convergence():
     errors, how, _, _ = _estimate(a, 2e-5, m)
     assert how[0] == "last steps" and errors[0] > 2e-5 and errors[0] >= 0.9006 - a[-1, 0]
     errors, how, _, _ = _estimate(a, 2e-5)
-    assert how[0] == "last steps" and errors[0] == pytest.approx(STILL * 1e-4 * (1 - m) * m ** 5, rel=1e-6)
+    assert how[0] == "last steps" and errors[0] == pytest.approx(DEFAULT.STILL * 1e-4 * (1 - m) * m ** 5, rel=1e-6)
 
 
 def test_an_extrapolation_does_not_claim_past_a_slow_mode_it_has_not_seen():
@@ -485,7 +512,7 @@ def test_an_extrapolation_does_not_claim_past_a_slow_mode_it_has_not_seen():
     and Aitken's extrapolation on them claimed 8e-7 where 7e-6 remained (at that point the
     cohort method claimed 1.4e-5 where 3.9e-5 remained, docs/validation/micro_cohort.md
     section 5).  With the slowest multiplier known, the claim covers the distance."""
-    from micro.cohort import _estimate
+    from micro.cohort.estimate import _estimate
     n = np.arange(13)
     a = np.tile((0.9 - 1e-4 * 0.96 ** n - 3e-5 * 0.982 ** n)[:, None], (1, 4))
     errors, how, best, _ = _estimate(a, 2e-5)
@@ -503,7 +530,7 @@ def test_a_stress_passing_through_zero_steps_is_bounded_by_the_state_s_move():
     stresses of the cycle (here sigma_min, on both modes with one sign) show how far the
     stresses move with it: the bound covers the distance.  A kink (a stress jumping where
     the loading phase changes its number of steps) does not set that response."""
-    from micro.cohort import _estimate, _state_tail
+    from micro.cohort.estimate import _estimate, _state_tail
     n = np.arange(24)
     u, v = 0.5 * 0.97 ** n, 0.15 * (0.97 / 0.9) ** 21.5 * 0.9 ** n  # (the modes, in mass)
     a = np.tile((0.9 + 1e-3 * (u - v))[:, None], (1, 6))
@@ -536,7 +563,8 @@ def test_a_run_on_plain_cycles_takes_the_state_s_move_as_a_bound():
 def test_anderson_beats_the_plain_cycles_close_to_vc():
     # k0 = 0.01, 0.9 V^c: the cycle map contracts by about 0.96 per cycle; fifteen cycles'
     # worth of Anderson's acceleration leaves a smaller residual than fifteen plain cycles
-    from micro.cohort import _anderson, _one_cycle
+    from micro.cohort.cycle import _one_cycle
+    from micro.cohort.solver import _anderson
     model = micro.Model(k0=0.01)
     V = 0.9 * micro.critical_velocity(model).Vc
     h, dt = model.kappa * model.zbar / 10.0, 0.004
@@ -593,7 +621,7 @@ def _near_vc_state():
 
 def _near_vc_product_cycle():
     """The product state of :func:`_near_vc_state`'s marginal, and its cycle."""
-    from micro.cohort import _product_cycle
+    from micro.cohort.cycle import _product_cycle
     model, V, h, step, st = _near_vc_state()
     x = st.dense(st.n - 1)
     x /= x.sum()
@@ -605,7 +633,7 @@ def test_a_cycle_at_frozen_slips_repeats_the_cycle_and_is_linear_in_the_marginal
     """With the slips of a cycle imposed, the cycle from its own start repeats it, and a
     sum of starting masses goes to the sum of their images (the floors and the crossings
     do not depend on the density): what the band preconditioner rests on."""
-    from micro.cohort import _frozen_cycle
+    from micro.cohort.cycle import _frozen_cycle
     model, V, h, x, out, g, _, _ = _near_vc_product_cycle()
     again = _frozen_cycle(model, V, h, out["start"], out["steps"], x)
     assert np.abs(again / again.sum() - g).sum() < 1e-10
@@ -624,8 +652,8 @@ def test_the_slow_modes_are_the_single_blocks_relaxing():
     relaxes by a^2: the slowest multiplier of the map at frozen slips (with the full map's
     response to a shift of the marginal, which moves the stress).  Newton's check with the whole Jacobian gives 0.9830
     here (benchmarks/results/micro_cohort_newton_check.csv)."""
-    from micro.cohort import _band_preconditioner
-    from micro.cohort import _product_cycle
+    from micro.cohort.cycle import _product_cycle
+    from micro.cohort.solver import _band_preconditioner
     model, V, h, x, out, g, step, ref = _near_vc_product_cycle()
     _, slowest = _band_preconditioner(model, V, h, lambda v: _product_cycle(model, V, h, step, ref, v), x, out, g)
     alpha = (model.k0 + model.k1) / model.kappa
@@ -698,7 +726,7 @@ def test_the_carried_cycle_from_a_state_is_its_own_cycle():
     marginal put back as it was is the same state, so its cycle is the plain one, and so is
     the count of blocks its shock left unjumped (it used to count the newborns too when
     storing them compacted the copy's cohorts: 0.99999 instead of 3e-34)."""
-    from micro.cohort import _carried_cycle
+    from micro.cohort.cycle import _carried_cycle
     _, _, _, step, st = _near_vc_state()
     plain = st.copy()
     row = _one_cycle(plain, step)
@@ -715,11 +743,11 @@ def test_anderson_halves_a_step_the_map_does_not_apply_to(monkeypatch):
     iteration halves it towards the last evaluated marginal and goes on, instead of
     ending there (as it did at k0 = 1e-3, 0.9 V^c in a sweep: 200 plain cycles after it,
     not converged)."""
-    from micro import cohort
+    from micro.cohort import solver
     model, V, h, x, out, g, step, ref = _near_vc_product_cycle()
     st = _start(model, V, h, None, dep=x)
     st.period_ref = ref
-    real, tried = cohort._carried_cycle, []
+    real, tried = solver._carried_cycle, []
 
     def flaky(base, step_, ref_, v):
         tried.append(v.copy())
@@ -727,8 +755,8 @@ def test_anderson_halves_a_step_the_map_does_not_apply_to(monkeypatch):
         if len(tried) == 3:  # (the second call is the preconditioner's shift)
             row = dict(row, unjumped=0.5)
         return state, row, image
-    monkeypatch.setattr(cohort, "_carried_cycle", flaky)
-    best, used, slow, _ = cohort._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 6)
+    monkeypatch.setattr(solver, "_carried_cycle", flaky)
+    best, used, slow, _ = solver._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 6)
     assert best is not None and used == 6 and 0.97 < slow < 1.0
     # the next evaluation is the midpoint of the first and the refused second
     assert np.abs(tried[3] - 0.5 * (tried[0] / tried[0].sum() + tried[2])).sum() < 1e-12
@@ -739,20 +767,20 @@ def test_anderson_stops_at_once_where_the_frozen_map_grows(monkeypatch):
     iteration does not contract (at k0 = 1e-3, 0.85 V^c its 35 evaluations wandered and
     were thrown away): Anderson returns after its first evaluation with that multiplier,
     and the caller solves by Newton-Krylov (docs/validation/micro_cohort.md section 5)."""
-    from micro import cohort
+    from micro.cohort import solver
     model, V, h, x, out, g, step, ref = _near_vc_product_cycle()
     st = _start(model, V, h, None, dep=x)
     st.period_ref = ref
-    real = cohort._band_preconditioner
+    real = solver._band_preconditioner
 
     def growing(*args, **kwargs):
         M, slowest = real(*args, **kwargs)
         return M, np.concatenate([[1.05], slowest[1:]])
-    monkeypatch.setattr(cohort, "_band_preconditioner", growing)
-    best, used, slow, residual = cohort._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 20)
+    monkeypatch.setattr(solver, "_band_preconditioner", growing)
+    best, used, slow, residual = solver._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 20)
     assert used == 1 and slow == 1.05 and best is not None and 0.0 < residual < 1.0
-    monkeypatch.setattr(cohort, "_band_preconditioner", real)
-    _, used, slow, _ = cohort._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 3)
+    monkeypatch.setattr(solver, "_band_preconditioner", real)
+    _, used, slow, _ = solver._anderson(model, V, h, step, 0.02, st, ref, 1e-12, 3)
     assert used == 3 and slow < 1.0
 
 
@@ -776,8 +804,8 @@ def _run_with_a_growing_frozen_map(monkeypatch):
     """k0 = 0.01, 0.9 V^c at dt = 0.04, cell kappa zbar / 10, from a cold start, with
     Anderson's frozen-slip map reported as growing (slowest multiplier 1.03); asserts that
     the run was accelerated, so that the caller exercises that path."""
-    from micro import cohort
-    real = cohort._anderson
+    from micro.cohort import solver
+    real = solver._anderson
     seen = []
 
     def growing(*args, **kwargs):
@@ -785,7 +813,7 @@ def _run_with_a_growing_frozen_map(monkeypatch):
         seen.append(slow)
         return best, used, 1.03, step
 
-    monkeypatch.setattr(cohort, "_anderson", growing)
+    monkeypatch.setattr(solver, "_anderson", growing)
     model = micro.Model(k0=0.01)
     V = 0.9 * micro.critical_velocity(model).Vc
     res = cycle_cohorts(model, V, dt=0.04, h=model.kappa * model.zbar / 10.0, start=_NO_COARSE)
@@ -798,10 +826,10 @@ def test_a_frozen_map_that_grows_leaves_the_fixed_point_uncertified(monkeypatch)
     # preconditioner) has a multiplier >= 1 nothing bounds a slower mode, and a pass of the
     # plain cycles' test was measured 3e-5 short of the fixed point (cell kappa zbar / 40,
     # docs/validation/micro_cohort.md section 5): the run must not claim to be converged.
-    from micro import cohort
+    from micro.cohort import newton, solver
     # (such a run is then solved by Newton-Krylov on the whole map, which certifies it:
     # here it finds no fixed point, as where its budget runs out)
-    monkeypatch.setattr(cohort, "_newton", lambda *a, **k: cohort._cohort_newton.NewtonKrylov(message="none"))
+    monkeypatch.setattr(solver, "_newton", lambda *a, **k: newton.NewtonKrylov(message="none"))
     res = _run_with_a_growing_frozen_map(monkeypatch)
     # the stopping test is met (so the row stands), but the error is not known
     assert res.converged and math.isnan(res.error)

@@ -16,7 +16,7 @@ import pytest
 import threadpoolctl
 
 import micro
-from micro import _cohort_kernels as CK
+from micro.cohort import kernels as CK
 from micro import _threads
 
 

@@ -1,7 +1,7 @@
 r"""Newton-Krylov on the cohort method's cycle map: a fixed point whose error is measured by
 its residual.
 
-The cycle map ``G`` (:func:`micro.cohort._carried_cycle`) takes the delta_R marginal ``x``
+The cycle map ``G`` (:func:`micro.cohort.cycle._carried_cycle`) takes the delta_R marginal ``x``
 of the blocks a shock made jump (node masses, summing to 1) through one loading phase and
 shock to the marginal of the blocks the next shock makes jump.  Close to V^c its
 multipliers crowd towards 1 (a continuum 0.98, 0.97, ...: docs/reference/micro_cohort.md,
@@ -37,19 +37,10 @@ from typing import Callable
 import numpy as np
 import scipy.sparse.linalg as sla
 
-#: The forward-difference step of a Jacobian-vector product, in mass (the marginal has mass 1).
-FD_STEP = 1e-5
-#: GMRES solves each Newton system to this relative residual (an inexact Newton step).  At
-#: k0 = 1e-3, V = 70 (0.87 V^c) the first step's residual falls to 1.5e-5 of the mass at
-#: 1e-2 and 1e-3 alike (the map's nonlinearity, not GMRES, limits it), in 15 cycles
-#: instead of 19, and the whole solve takes 33 cycles instead of 44 (sigma_max within 2e-8).
-GMRES_RTOL = 1e-2
-#: At most this many Jacobian-vector products (cycles) per Newton step.
-GMRES_MAX = 60
-#: Halvings of a Newton step whose residual did not fall, before the iteration stops.
-BACKTRACKS = 3
-#: Newton steps at most.
-NEWTON_MAX = 8
+from . import options
+
+# (its constants, FD_STEP, GMRES_RTOL, GMRES_MAX, NEWTON_BACKTRACKS and NEWTON_MAX, are fields of
+# micro.cohort.options.CohortOptions, with the measurements that set them)
 
 __all__ = ["NewtonKrylov", "solve"]
 
@@ -104,8 +95,9 @@ def solve(G: Callable, x0: np.ndarray, *, tol: float, max_evals: int,
 
     Stops when a full Newton step changed each of ``columns`` (keys of the row) by at most
     ``tol`` (certified, with those changes as the errors), when a step no longer lowers the
-    residual after BACKTRACKS halvings (the map's round-off), after NEWTON_MAX steps, or
+    residual after NEWTON_BACKTRACKS halvings (the map's round-off), after NEWTON_MAX steps, or
     when ``max_evals`` cycles are used."""
+    opt = options.DEFAULT
     res = NewtonKrylov()
 
     def G1(v: np.ndarray):
@@ -127,13 +119,13 @@ def solve(G: Callable, x0: np.ndarray, *, tol: float, max_evals: int,
     norm = float(np.abs(r).sum())
     res.state, res.row, res.x, res.residual = st, row, x, norm
     res.history.append((res.evals, norm, row["sigma_max"]))
-    for newton in range(NEWTON_MAX):
+    for newton in range(opt.NEWTON_MAX):
         def matvec(v: np.ndarray, x=x, g=g) -> np.ndarray:
             v = np.ravel(v)
             nv = float(np.abs(v).sum())
             if nv == 0.0:
                 return np.zeros_like(v)
-            e = FD_STEP / nv
+            e = opt.FD_STEP / nv
             _, _, gp = G1(x + e * v)
             if gp is None:
                 raise _MapFailed("a Jacobian-vector product left the map's domain")
@@ -145,12 +137,12 @@ def solve(G: Callable, x0: np.ndarray, *, tol: float, max_evals: int,
             res.message = f"the budget of {max_evals} cycles is used up"
             break
         try:
-            d, _ = sla.gmres(A, r, rtol=GMRES_RTOL, atol=0.0, restart=min(GMRES_MAX, room), maxiter=1)
+            d, _ = sla.gmres(A, r, rtol=opt.GMRES_RTOL, atol=0.0, restart=min(opt.GMRES_MAX, room), maxiter=1)
         except _MapFailed as err:
             res.message = str(err)
             break
         lam, accepted, full = 1.0, None, None
-        for _ in range(BACKTRACKS + 1):
+        for _ in range(opt.NEWTON_BACKTRACKS + 1):
             xn = _normalised(x + lam * d)
             try:
                 stn, rown, gn = G1(xn)
@@ -207,7 +199,7 @@ def solve(G: Callable, x0: np.ndarray, *, tol: float, max_evals: int,
                                f"{res.evals} cycles; the last step moved sigma_max by {change['sigma_max']:.1e}")
                 break
     else:
-        res.message = f"no certified fixed point in {NEWTON_MAX} Newton steps"
+        res.message = f"no certified fixed point in {opt.NEWTON_MAX} Newton steps"
     if not res.certified and not res.message:
         res.message = "no certified fixed point"
     return res

@@ -28,7 +28,7 @@ import types
 import numpy as np
 from numba import njit, prange
 
-from ._threads import one_numba_thread, use_free_cores
+from .._threads import one_numba_thread, use_free_cores
 
 #: The cohorts are summed in this many interleaved chunks (the order of the sums does not
 #: depend on the number of threads), in parallel from PARALLEL_COHORTS cohorts on.
