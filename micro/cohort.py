@@ -51,7 +51,8 @@ from . import _cohort_kernels as CK
 from . import _cohort_newton
 from . import _progress
 from ._threads import blas_single_threaded
-from .params import KIND_EXPONENTIAL, Model
+from .methods import CUTOFF_TAIL, cohort_not_applicable as not_applicable  # noqa: F401  (micro.cohort's names)
+from .params import Model
 from .results import CycleFixedPoint
 
 __all__ = ["cycle_cohorts"]
@@ -1046,24 +1047,6 @@ def _relaxation_multiplier(model: Model, period: float) -> float:
         return 0.0
     alpha = (model.k0 + model.k1) / model.kappa
     return 1.0 - alpha * (1.0 - math.exp(-model.gamma * period))
-
-
-#: The cohort method takes an Exponential whose cutoff removes at most this fraction of the
-#: jumps (exp(-cutoff / zbar) <= 1e-13, cutoff >= 30 zbar): a jumped block's margin is
-#: then Exp(kappa zbar) to double precision.  A closer cutoff changes the margins at order
-#: exp(-cutoff / zbar) (cutoff = 3 zbar: sigma_min 1.3e-2 off, tests/micro/test_cohort_parameters.py).
-CUTOFF_TAIL = 1e-13
-
-
-def not_applicable(model: Model) -> str:
-    """Why the cohort method does not apply to ``model``'s jumps ("" if it does)."""
-    jumps = model.jumps
-    if jumps.kind != KIND_EXPONENTIAL:
-        return "the cohort method needs exponential jumps (a jumped block's margin is then Exp(kappa zbar))"
-    if math.exp(-jumps.cutoff / jumps.zbar) > CUTOFF_TAIL:
-        return (f"the cohort method needs exponential jumps whose cutoff removes a negligible tail "
-                f"(cutoff >= 30 zbar = {30 * jumps.zbar:g}, got {jumps.cutoff:g})")
-    return ""
 
 
 @blas_single_threaded

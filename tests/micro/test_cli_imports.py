@@ -1,6 +1,7 @@
 """``import micro`` loads none of its submodules (PEP 562: each public name on first use),
-so that a command line can say a bad argument before it imports the modules that compute
-(pandas, scipy, numba: most of a second)."""
+and the modules that check arguments load neither pandas nor numba nor scipy, so that a
+command line can say a bad argument before it imports the modules that compute (most of a
+second)."""
 from __future__ import annotations
 
 import ast
@@ -13,6 +14,21 @@ import pytest
 import micro
 
 ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize("modules, not_loaded", [
+    # what the command line checks its arguments with: the model, the methods' options, the
+    # protocols, the output paths, the progress lines
+    ("micro.params, micro.methods, micro.protocols, micro._outputs, micro._progress",
+     ("pandas", "numba", "scipy", "micro.grid", "micro.cohort")),
+    # V^c (micro.renewal.cached_vc): numba's kernels and scipy's root finder, no pandas
+    ("micro.renewal", ("pandas", "micro.grid", "micro.cohort", "micro.fp", "micro.api")),
+])
+def test_what_the_checks_import_loads_nothing_they_do_not_need(modules, not_loaded):
+    code = f"import sys, {modules}; print(sorted(m for m in sys.modules if m.startswith({not_loaded!r})))"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"}, timeout=120)
+    assert done.stdout.strip() == "[]", done.stdout
 
 
 def test_import_micro_loads_no_submodule_and_every_public_name_on_use():
