@@ -22,11 +22,13 @@ def _main(package: str):
 
 
 #: Where each command line starts computing: the solver entry points its CLI calls (and,
-#: for compare, the task runner behind every computation of the report).
+#: for compare, the task runner behind every computation of the report), by module (micro's
+#: command line imports them from their modules when a command runs, after its checks).
 COMPUTE = {
-    "micro": ("micro.cli", ["critical_velocity", "simulate", "sweep", "steady_sliding"]),
-    "rsf": ("rsf.cli", ["critical_velocity", "simulate", "sweep"]),
-    "compare": ("compare.report", ["Runner"]),
+    "micro": [("micro.api", ["critical_velocity", "simulate", "sweep"]), ("micro.renewal", ["steady_sliding"]),
+              ("micro.branch", ["cycle_branch"])],
+    "rsf": [("rsf.cli", ["critical_velocity", "simulate", "sweep"])],
+    "compare": [("compare.report", ["Runner"])],
 }
 
 
@@ -34,16 +36,16 @@ def _spy_on_computing(package: str, monkeypatch) -> list[str]:
     """Replace the package's entry points by spies that record the call and stop it."""
     import importlib
 
-    module_name, names = COMPUTE[package]
-    module = importlib.import_module(module_name)
     calls: list[str] = []
-    for name in names:
-        assert callable(getattr(module, name)), (module_name, name)  # the spy must replace something real
+    for module_name, names in COMPUTE[package]:
+        module = importlib.import_module(module_name)
+        for name in names:
+            assert callable(getattr(module, name)), (module_name, name)  # the spy must replace something real
 
-        def spy(*args, _name=name, **kwargs):
-            calls.append(_name)
-            raise RuntimeError(f"{_name} was called: bad input reached the computation")
-        monkeypatch.setattr(module, name, spy)
+            def spy(*args, _name=name, **kwargs):
+                calls.append(_name)
+                raise RuntimeError(f"{_name} was called: bad input reached the computation")
+            monkeypatch.setattr(module, name, spy)
     return calls
 
 
