@@ -458,6 +458,8 @@ def _run(args, kept: list[str]) -> int:
     numerics, convergence, cohort = _options(args, models)
     if args.command == "steady":
         velocities = _floats(args.V, "V", *V_RANGE)
+        import pandas  # noqa: F401  (the table's, SteadySliding.to_frame: imported before the clock starts)
+
         from .renewal import steady_sliding
 
         start = _started()

@@ -23,15 +23,22 @@ ROOT = Path(__file__).resolve().parents[2]
 HEAVY = ("pandas", "numba", "scipy", "micro.renewal", "micro.api", "micro.branch", "micro.cohort", "micro.fp",
          "micro.grid")
 
-#: Runs ``python -m micro ARGS`` as ``-m`` does, and prints at exit which of HEAVY were imported.
+#: Runs ``python -m micro ARGS`` as ``-m`` does, and prints at exit which of HEAVY were imported
+#: (micro/__main__.py ends a refused call by os._exit, skipping the interpreter's teardown).
 PROBE = f"""
-import atexit, runpy, sys
+import os, runpy, sys
 HEAVY = {HEAVY!r}
-atexit.register(lambda: print(" ".join(sorted({{next(h for h in HEAVY if m == h or m.startswith(h + "."))
-                                                for m in sys.modules
-                                                if any(m == h or m.startswith(h + ".") for h in HEAVY)}}))))
+def loaded():
+    print(" ".join(sorted({{next(h for h in HEAVY if m == h or m.startswith(h + "."))
+                            for m in sys.modules if any(m == h or m.startswith(h + ".") for h in HEAVY)}})),
+          flush=True)
+exit_now = os._exit
+os._exit = lambda code: (loaded(), exit_now(code))
 sys.argv[0] = "micro"
-runpy.run_module("micro", run_name="__main__", alter_sys=True)
+try:
+    runpy.run_module("micro", run_name="__main__", alter_sys=True)
+finally:
+    loaded()
 """
 
 
