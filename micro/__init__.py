@@ -25,16 +25,20 @@ The obvious entry points::
 """
 from __future__ import annotations
 
-from .grid import GridTooLarge
-from .analytic import sigma_deterministic_steady, sigma_fast_limit, sigma_slow_limit
-from .params import Deterministic, Exponential, JumpDistribution, Model, Tabulated
-from .protocols import Drive
-from .renewal import (SteadySliding, characteristic_function, growth_rate_near_vc, steady_sliding,
-                      unstable_mode_count, vc_small_k0)
-from .methods import FP, Auto, Cohort, Convergence, Numerics, Renewal, default_eps
-from .results import Critical, CycleFixedPoint, Run, Stationary
-from .api import critical_velocity, simulate, slide_hold_slide, stationary, sweep
-from .branch import Branch, cycle_branch
+from importlib import import_module as _import_module
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # pragma: no cover  (for type checkers and IDEs: the names are loaded on first use)
+    from .grid import GridTooLarge
+    from .analytic import sigma_deterministic_steady, sigma_fast_limit, sigma_slow_limit
+    from .params import Deterministic, Exponential, JumpDistribution, Model, Tabulated
+    from .protocols import Drive
+    from .renewal import (SteadySliding, characteristic_function, growth_rate_near_vc, steady_sliding,
+                          unstable_mode_count, vc_small_k0)
+    from .methods import FP, Auto, Cohort, Convergence, Numerics, Renewal, default_eps
+    from .results import Critical, CycleFixedPoint, Run, Stationary
+    from .api import critical_velocity, simulate, slide_hold_slide, stationary, sweep
+    from .branch import Branch, cycle_branch
 
 __all__ = [
     "Model",
@@ -72,3 +76,40 @@ __all__ = [
     "sigma_fast_limit",
     "sigma_slow_limit",
 ]
+
+#: The submodule of each public name: ``import micro`` loads none of them (numba, scipy and
+#: pandas take most of a second, which a command line's bad-input error should not wait
+#: for); each is imported on first use of one of its names (PEP 562).
+_SOURCES = {
+    "grid": ("GridTooLarge",),
+    "analytic": ("sigma_deterministic_steady", "sigma_fast_limit", "sigma_slow_limit"),
+    "params": ("Deterministic", "Exponential", "JumpDistribution", "Model", "Tabulated"),
+    "protocols": ("Drive",),
+    "renewal": ("SteadySliding", "characteristic_function", "growth_rate_near_vc", "steady_sliding",
+                "unstable_mode_count", "vc_small_k0"),
+    "methods": ("FP", "Auto", "Cohort", "Convergence", "Numerics", "Renewal", "default_eps"),
+    "results": ("Critical", "CycleFixedPoint", "Run", "Stationary"),
+    "api": ("critical_velocity", "simulate", "slide_hold_slide", "stationary", "sweep"),
+    "branch": ("Branch", "cycle_branch"),
+}
+_MODULE_OF = {name: module for module, names in _SOURCES.items() for name in names}
+
+
+def __getattr__(name: str):
+    """A public name from its submodule (imported now, kept), or a submodule (``micro.cohort``)."""
+    module = _MODULE_OF.get(name)
+    if module is not None:
+        value = getattr(_import_module(f".{module}", __name__), name)
+        globals()[name] = value
+        return value
+    if not name.startswith("__"):
+        try:
+            return _import_module(f".{name}", __name__)
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":   # (a submodule that exists but fails to import says so)
+                raise
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_MODULE_OF))

@@ -24,7 +24,7 @@ import time
 from contextvars import ContextVar
 from typing import Callable, Iterator, Union
 
-__all__ = ["CHUNK_SECONDS", "Interrupted", "beat", "stage", "reporting"]
+__all__ = ["CHUNK_SECONDS", "Interrupted", "beat", "stage", "reporting", "restart"]
 
 Text = Union[str, Callable[[], str]]
 
@@ -49,6 +49,7 @@ class _Reporter:
     def __init__(self, callback: Callable[[str, float], None], first: float, interval: float,
                  longest: float) -> None:
         self.callback = callback
+        self.first = first
         self.start = time.monotonic()
         self.due = self.start + first
         self.interval = interval
@@ -112,6 +113,16 @@ def stage(text: Text) -> Iterator[None]:
         yield
     finally:
         rep.stages.pop()
+
+
+def restart() -> None:
+    """Start the installed reporter's clock again, its first report due ``first`` seconds
+    from now: a command line that imports its computing modules only after checking its
+    input calls it when the computation begins (the imports are not computing)."""
+    rep = _REPORTER.get()
+    if rep is not None:
+        rep.start = time.monotonic()
+        rep.due = rep.start + rep.first
 
 
 @contextlib.contextmanager

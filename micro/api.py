@@ -25,7 +25,6 @@ from __future__ import annotations
 import logging
 import math
 import time
-from functools import lru_cache
 
 import numpy as np
 import pandas as pd
@@ -36,7 +35,7 @@ from .cohort import cycle_cohorts, not_applicable as cohort_not_applicable, opti
 from .methods import COHORT_STEPS_MAX, FP, Auto, Cohort, Convergence, Method, Renewal, check_velocity, resolve
 from .params import Model, _number
 from .protocols import Drive
-from .renewal import V_RANGE, critical_velocity_renewal, steady_sliding
+from .renewal import V_RANGE, cached_vc as _vc, critical_velocity_renewal, steady_sliding
 from .results import BELOW, Critical, CycleFixedPoint, Run, Stationary
 
 __all__ = ["stationary", "sweep", "critical_velocity", "simulate", "slide_hold_slide"]
@@ -71,12 +70,6 @@ def _check_numerics(numerics, method: Method) -> FP | None:
     if given is not None and given != numerics:
         raise ValueError("give the Fokker-Planck options once: as method=micro.FP(...) or as numerics=, not both")
     return numerics
-
-
-@lru_cache(maxsize=64)
-def _vc(model: Model) -> float:
-    """V^c from the renewal chain (cached per model: it serves every row of a sweep)."""
-    return float(critical_velocity_renewal(model)[0])
 
 
 # ------------------------------------------------------------------------------ stationary

@@ -32,10 +32,11 @@ import numpy as np
 import pandas as pd
 
 from . import _progress
-from .api import NEAR_VC, _check_model, _vc, check_cohort_work, stationary
-from .cohort import cycle_multipliers, not_applicable as cohort_not_applicable
+from ._branch_checks import check_arguments, check_start
+from .api import NEAR_VC, _vc, check_cohort_work, stationary
+from .cohort import cycle_multipliers
 from .methods import Auto, Cohort
-from .params import Model, _number
+from .params import Model
 
 __all__ = ["Branch", "cycle_branch", "COLUMNS"]
 
@@ -81,47 +82,14 @@ class Branch:
     wall_time: float
 
 
-def _check_d(value, name: str) -> float:
-    value = _number(name, value)
-    if not 0.0 < value < 1.0:
-        raise ValueError(f"{name} must be in (0, 1) (d = 1 - V/V^c: 0 is V^c itself, 1 is V = 0); "
-                         f"the branch of stick-slip cycles is continued below V^c only, got {value!r}")
-    return value
-
-
 def _check_inputs(model: Model, V_start, d_min, max_error, max_points, method,
                   multipliers) -> tuple[float, float, Auto]:
     """Every argument, before anything long is computed (V^c takes milliseconds)."""
-    _check_model(model)
-    why = cohort_not_applicable(model)
-    if why:
-        raise ValueError(f"model: cycle_branch computes its cycles by the cohort method, and {why}; other jump "
-                         "laws have the Fokker-Planck time-stepping only: micro.sweep(model, V, method='fp')")
-    d_min = _check_d(d_min, "d_min")
-    if not 0.0 < _number("max_error", max_error) <= 1.0:
-        raise ValueError(f"max_error must be in (0, 1] (a fraction of the amplitude), got {max_error!r}")
-    if not (isinstance(max_points, int) and not isinstance(max_points, bool) and max_points >= 2):
-        raise ValueError(f"max_points must be an integer >= 2, got {max_points!r}")
-    if not isinstance(multipliers, bool):
-        raise ValueError(f"multipliers must be True or False, got {multipliers!r}")
-    if isinstance(method, Cohort):
-        method = Auto(cohort=method)
-    if not isinstance(method, Auto):
-        raise ValueError(f"method must be a micro.Cohort or micro.Auto (the cohort method's options), got "
-                         f"{type(method).__name__}")
-    Vc = _vc(model)
-    if V_start is None:
-        V_start = 0.2 * Vc
-    if not 0.0 < _number("V_start", V_start) < Vc:
-        raise ValueError(f"V_start must be in (0, V^c = {Vc:.6g}) (stick-slip; above V^c steady sliding is stable "
-                         f"and there is no cycle to start from), got {V_start!r}")
-    d_start = 1.0 - V_start / Vc
-    if not d_start > d_min:
-        raise ValueError(f"d_min must be below the start's d = {d_start:.4g} (V_start = {V_start:g}, "
-                         f"V^c = {Vc:.6g}), got {d_min!r}")
+    d_min, method = check_arguments(model, d_min, max_error, max_points, method, multipliers)
+    V_start = check_start(V_start, d_min, _vc(model))
     method.cohort.cell(model)
-    check_cohort_work(model, float(V_start), method.cohort)
-    return float(V_start), d_min, method
+    check_cohort_work(model, V_start, method.cohort)
+    return V_start, d_min, method
 
 
 def _point(res, d: float, max_error: float, multipliers: bool) -> dict:

@@ -7,6 +7,10 @@ stick-slip cycles, the Fokker-Planck equation for a protocol's transient.  A met
 options are flags of their own (``--eps`` the Fokker-Planck bin, ``--cohort-dt`` and
 ``--cohort-h`` the cohort's step and cell); a flag for a method the command does not use
 is an error.
+
+Every argument is checked before the modules that compute are imported (pandas, scipy and
+numba take most of a second): a bad one is said at once.  A check that needs V^c (``micro
+branch``'s ``--V-start``) loads the renewal chain only.
 """
 from __future__ import annotations
 
@@ -19,18 +23,17 @@ import os
 import sys
 import time
 from pathlib import Path
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from . import _outputs
-from ._progress import Interrupted, reporting
-from .api import critical_velocity, simulate, sweep
-from .branch import cycle_branch
-from .fp import TooLong
+from ._branch_checks import check_arguments as check_branch_arguments, check_start as check_branch_start
+from ._progress import Interrupted, reporting, restart
 from .methods import FP, RETIRED, Auto, Cohort, Convergence, default_eps
 from .params import Deterministic, Exponential, Model
 from .protocols import Drive
-from .renewal import steady_sliding
+
+if TYPE_CHECKING:  # pragma: no cover  (imported where a command computes, after its checks)
+    import pandas as pd
 
 log = logging.getLogger("micro")
 
@@ -349,6 +352,13 @@ def main(argv: list[str] | None = None) -> int:
         return 130
 
 
+def _started() -> float:
+    """The computation begins (its modules imported): the clock of the times printed, and of
+    the progress lines, which start ``first`` = 0.2 s later."""
+    restart()
+    return time.perf_counter()
+
+
 def _progress_line(prefix: str):
     """The command line's progress callback: one line on stderr per report (every second
     at first, then every 2, 4, ... up to 10 seconds)."""
@@ -437,9 +447,9 @@ def _check_critical_range(args) -> None:
 
 def _run(args, kept: list[str]) -> int:
     """Run the command; ``kept`` gets a line saying what is on disk after each write (the
-    message of a Ctrl-C)."""
-    start = time.perf_counter()
-    # everything is checked before anything is computed
+    message of a Ctrl-C).  Everything is checked before anything is computed, and before the
+    modules that compute are imported; the times printed start once they are (as they did
+    when they were imported with this module)."""
     out = _check_out(args.out)
     k0s = _floats(args.k0, "k0", 0.0, K0_MAX) if args.command == "critical" else [args.k0]
     if args.command != "critical" and not (math.isfinite(args.k0) and 0.0 < args.k0 <= K0_MAX):
@@ -448,6 +458,11 @@ def _run(args, kept: list[str]) -> int:
     numerics, convergence, cohort = _options(args, models)
     if args.command == "steady":
         velocities = _floats(args.V, "V", *V_RANGE)
+        import pandas  # noqa: F401  (the table's, SteadySliding.to_frame: imported before the clock starts)
+
+        from .renewal import steady_sliding
+
+        start = _started()
         res = steady_sliding(models[0], velocities, growth_rate=args.growth_rate)
         frame = res.to_frame()
         _write_csv(frame, out)
@@ -457,6 +472,9 @@ def _run(args, kept: list[str]) -> int:
     if args.command == "sweep":
         velocities = _floats(args.V, "V", *V_RANGE)
         method = "fp" if args.method == "fp" else cohort if args.method == "cohort" else Auto(cohort=cohort)
+        from .api import sweep
+
+        start = _started()
 
         def row_done(frame: pd.DataFrame) -> None:
             _keep_so_far(frame, out, kept, f"{len(frame)} of {len(velocities)} rows")
@@ -475,9 +493,14 @@ def _run(args, kept: list[str]) -> int:
         print(f"wrote {len(frame)} rows to {out} in {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return 0 if frame.converged.all() else 3
     if args.command == "branch":
-        return _branch(args, models[0], cohort, out, kept, start)
+        return _branch(args, models[0], cohort, out, kept)
     if args.command == "critical":
         _check_critical_range(args)
+        import pandas as pd
+
+        from .api import critical_velocity
+
+        start = _started()
         rows = []
         for i, model in enumerate(models):
             with _critical_flags():
@@ -513,6 +536,10 @@ def _run(args, kept: list[str]) -> int:
             _bounded(value, f"--shs {name}", 0.0, T_MAX, open_low=name != "HOLD")
         _bounded(slide + hold + resume, "--shs SLIDE + HOLD + RESUME", 0.0, T_MAX, open_low=True)
         drive = Drive.slide_hold_slide(v, slide, hold, resume)
+    from .api import simulate
+    from .fp import TooLong
+
+    start = _started()
     try:
         run = simulate(models[0], drive, numerics=numerics, max_wall_time=RUN_HOURS_MAX * 3600.0)
     except TooLong as exc:  # (the option the user typed: --duration, or the protocol's)
@@ -537,9 +564,32 @@ _BRANCH_FLAGS = {"V_start": "--V-start", "d_min": "--d-min", "max_error": "--max
                  "max_points": "--max-points", "Cohort dt": "--cohort-dt", "Cohort h": "--cohort-h"}
 
 
-def _branch(args, model: Model, cohort: Cohort, out: _outputs.Target, kept: list[str], start: float) -> int:
+@contextlib.contextmanager
+def _branch_flags():
+    """A ValueError of :func:`micro.cycle_branch` (or of its checks) names the flags, not the parameters."""
+    try:
+        yield
+    except ValueError as exc:
+        raise ValueError(_as_flags(str(exc).replace("model: ", "--dist: ", 1), _BRANCH_FLAGS)) from None
+
+
+def _branch(args, model: Model, cohort: Cohort, out: _outputs.Target, kept: list[str]) -> int:
     """``micro branch``: the points written after each one; exit 0 when the walk reached
-    --d-min with every point certified, 3 when it ended before (the reason on stderr)."""
+    --d-min with every point certified, 3 when it ended before (the reason on stderr).
+
+    micro.cycle_branch's checks run first on their own, in its order: those that need no
+    V^c, then the start against V^c from the renewal chain alone (cached: the branch reuses
+    it); pandas, scipy's solvers and the cohort's kernels are imported only after them."""
+    with _branch_flags():
+        d_min, _ = check_branch_arguments(model, args.d_min, args.max_error, args.max_points, cohort,
+                                          args.multipliers)
+        from .renewal import cached_vc
+
+        check_branch_start(args.V_start, d_min, cached_vc(model))
+    from .branch import cycle_branch
+
+    start = _started()
+
     def point_done(frame: pd.DataFrame) -> None:
         _keep_so_far(frame, out, kept, f"{len(frame)} points")
         last = frame.iloc[-1]
@@ -549,12 +599,10 @@ def _branch(args, model: Model, cohort: Cohort, out: _outputs.Target, kept: list
               + (f", leading multiplier {last.floquet_1:.4f}" if args.multipliers else "")
               + ("" if last.certified else ", NOT certified"), file=sys.stderr)
 
-    try:
+    with _branch_flags():
         res = cycle_branch(model, args.V_start, d_min=args.d_min, max_error=args.max_error,
                            max_points=args.max_points, method=cohort, multipliers=args.multipliers,
                            on_point=point_done)
-    except ValueError as exc:  # (name the flags the user typed)
-        raise ValueError(_as_flags(str(exc).replace("model: ", "--dist: ", 1), _BRANCH_FLAGS)) from None
     if not out.replaceable or res.points.empty:
         _write_csv(res.points, out)
     print(f"wrote {len(res.points)} points to {out} in {time.perf_counter() - start:.1f} s; {res.reason}",

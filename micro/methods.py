@@ -21,10 +21,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import ClassVar, Union
+from typing import TYPE_CHECKING, ClassVar, Union
 
-from .grid import GridSettings
-from .params import Model, _number
+from .params import KIND_EXPONENTIAL, Model, _number
+
+if TYPE_CHECKING:  # pragma: no cover  (micro.grid loads the Fokker-Planck kernels: imported where used)
+    from .grid import GridSettings
 
 __all__ = ["FP", "Numerics", "Cohort", "Renewal", "Auto", "Convergence", "METHODS", "resolve", "default_eps",
            "check_velocity"]
@@ -107,6 +109,8 @@ class FP:
 
     def settings(self, model: Model) -> GridSettings:
         """The grid's settings for ``model`` (a ValueError naming eps if it is out of range)."""
+        from .grid import GridSettings
+
         eps = default_eps(model) if self.eps is None else float(self.eps)
         settings = GridSettings(eps=eps, theta_shift=self.theta_shift, theta_relax=self.theta_relax, dt_max=math.inf,
                                 max_bytes=self.max_memory_gib * 2**30)
@@ -213,6 +217,26 @@ class Cohort:
                              f"zbar / {COHORT_CELLS_MAX:.0e}, the delta_R grid's span over its largest cell count), "
                              f"got {h:g}")
         return h
+
+
+#: The cohort method takes an Exponential whose cutoff removes at most this fraction of the
+#: jumps (exp(-cutoff / zbar) <= 1e-13, cutoff >= 30 zbar): a jumped block's margin is
+#: then Exp(kappa zbar) to double precision.  A closer cutoff changes the margins at order
+#: exp(-cutoff / zbar) (cutoff = 3 zbar: sigma_min 1.3e-2 off, tests/micro/test_cohort_parameters.py).
+CUTOFF_TAIL = 1e-13
+
+
+def cohort_not_applicable(model: Model) -> str:
+    """Why the cohort method does not apply to ``model``'s jumps ("" if it does); here, not
+    in :mod:`micro.cohort` (also ``micro.cohort.not_applicable``), so that a command line
+    refuses such a model before it loads the cohort's kernels."""
+    jumps = model.jumps
+    if jumps.kind != KIND_EXPONENTIAL:
+        return "the cohort method needs exponential jumps (a jumped block's margin is then Exp(kappa zbar))"
+    if math.exp(-jumps.cutoff / jumps.zbar) > CUTOFF_TAIL:
+        return (f"the cohort method needs exponential jumps whose cutoff removes a negligible tail "
+                f"(cutoff >= 30 zbar = {30 * jumps.zbar:g}, got {jumps.cutoff:g})")
+    return ""
 
 
 @dataclass(frozen=True)

@@ -45,9 +45,10 @@ import logging
 import math
 import numbers
 from dataclasses import dataclass, field
+from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 from numpy.polynomial.legendre import leggauss
 from scipy.optimize import brentq
 
@@ -56,6 +57,9 @@ from ._threads import blas_single_threaded
 from .analytic import _check_model
 from .params import KIND_DETERMINISTIC, KIND_EXPONENTIAL, Model
 from .results import ABOVE, BELOW
+
+if TYPE_CHECKING:  # pragma: no cover  (pandas only for the tables: V^c does without it)
+    import pandas as pd
 
 __all__ = ["SteadySliding", "steady_sliding", "critical_velocity_renewal", "characteristic_function",
            "growth_rate_near_vc", "unstable_mode_count", "vc_small_k0"]
@@ -606,6 +610,8 @@ class SteadySliding:
     message: str = field(default="")
 
     def to_frame(self) -> pd.DataFrame:
+        import pandas as pd
+
         m = self.model
         n = np.size(self.V)
         return pd.DataFrame({
@@ -763,6 +769,13 @@ def vc_small_k0(model: Model) -> float:
     """
     _check_model(model)
     return model.k2 * model.gamma * model.jumps.mean_residual / model.k0
+
+
+@lru_cache(maxsize=64)
+def cached_vc(model: Model) -> float:
+    """V^c from the renewal chain (:func:`critical_velocity_renewal`), cached per model: it
+    serves every row of a sweep, and a command line's check of its arguments once more."""
+    return float(critical_velocity_renewal(model)[0])
 
 
 @blas_single_threaded

@@ -12,11 +12,12 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from .params import Model
 
-if TYPE_CHECKING:  # pragma: no cover
+if TYPE_CHECKING:  # pragma: no cover  (pandas only in annotations: the renewal chain's V^c does without it)
+    import pandas as pd
+
     from .grid import Grid
 
 __all__ = ["Run", "Stationary", "Critical", "CycleFixedPoint"]

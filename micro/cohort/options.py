@@ -21,8 +21,9 @@ above each field; docs/reference/micro_cohort.md and docs/validation/micro_cohor
 The field names are those the measurements name (they were module constants of
 ``micro/cohort.py``).  Not here: the kernels' constants (``micro.cohort.kernels``:
 ``CHUNKS``, ``PARALLEL_COHORTS``, ``ROUND``), which numba compiles into the cached
-kernels, and ``WINDOW`` (``micro.cohort.estimate``: the error rules' formulas are written
-for five cycles).
+kernels, ``WINDOW`` (``micro.cohort.estimate``: the error rules' formulas are written
+for five cycles), and ``CUTOFF_TAIL`` (``micro.methods``, with the check of where the method
+applies: a command line makes it before it loads the cohort's kernels).
 
 The solver reads :data:`DEFAULT` when it needs a constant, so replacing it (a test's
 ``monkeypatch.setattr(options, "DEFAULT", dataclasses.replace(options.DEFAULT, ...))``,
@@ -173,15 +174,9 @@ class CohortOptions:
     #: replayed (studies/micro_cohort_state_tail_check.py, docs/validation/micro_cohort.md
     #: section 5).
     SENSITIVITY_WINDOW: int = 20
-    # ---------------------------------------------------------------- where it applies
-    #: The cohort method takes an Exponential whose cutoff removes at most this fraction of the
-    #: jumps (exp(-cutoff / zbar) <= 1e-13, cutoff >= 30 zbar): a jumped block's margin is
-    #: then Exp(kappa zbar) to double precision.  A closer cutoff changes the margins at order
-    #: exp(-cutoff / zbar) (cutoff = 3 zbar: sigma_min 1.3e-2 off, tests/micro/test_cohort_parameters.py).
-    CUTOFF_TAIL: float = 1e-13
 
     def __post_init__(self) -> None:
-        below_one = ("SLOW_CAVEAT", "AITKEN_MAX_RATIO", "ANDERSON_UNJUMPED", "CUTOFF_TAIL")
+        below_one = ("SLOW_CAVEAT", "AITKEN_MAX_RATIO", "ANDERSON_UNJUMPED")
         for f in dataclasses.fields(self):
             value, name = getattr(self, f.name), f.name
             if f.type == "int":

@@ -22,7 +22,8 @@ import scipy.linalg
 from . import newton as _cohort_newton
 from . import options
 from .._threads import blas_single_threaded
-from ..params import KIND_EXPONENTIAL, Model
+from ..methods import cohort_not_applicable as not_applicable
+from ..params import Model
 from ..results import CycleFixedPoint
 from .cycle import (_carried_cycle, _frozen_cycle, _marginal, _one_cycle, _phase_step, _step_off, _step_too_long,
                     _trace)
@@ -275,18 +276,6 @@ def _map_multipliers(base: _Cohorts, step: float, ref: float, x: np.ndarray, k: 
     vals = sla.eigs(op, k=k, which="LM", ncv=min(ncv, S.size - 1), tol=tol, v0=v0 / np.linalg.norm(v0),
                     return_eigenvectors=False)
     return vals[np.argsort(-np.abs(vals))], cycles[0]
-
-
-def not_applicable(model: Model) -> str:
-    """Why the cohort method does not apply to ``model``'s jumps ("" if it does)."""
-    opt = options.DEFAULT
-    jumps = model.jumps
-    if jumps.kind != KIND_EXPONENTIAL:
-        return "the cohort method needs exponential jumps (a jumped block's margin is then Exp(kappa zbar))"
-    if math.exp(-jumps.cutoff / jumps.zbar) > opt.CUTOFF_TAIL:
-        return (f"the cohort method needs exponential jumps whose cutoff removes a negligible tail "
-                f"(cutoff >= 30 zbar = {30 * jumps.zbar:g}, got {jumps.cutoff:g})")
-    return ""
 
 
 @blas_single_threaded

@@ -82,15 +82,18 @@ def test_cli_critical_writes_the_documented_columns(tmp_path):
 def test_cli_critical_fp_options_reach_the_bisection(tmp_path, monkeypatch):
     # --method fp and its numerics (a bisection costs 8+ s, so the call is intercepted and
     # answered by the direct method): a dropped --no-refine, --eps or --method passes silently
+    import micro.api
     import micro.cli as cli
 
     seen = []
+    direct = micro.api.critical_velocity
 
     def spy(model, **kw):
         seen.append((model, kw))
-        return micro.critical_velocity(model)
+        return direct(model)
 
-    monkeypatch.setattr(cli, "critical_velocity", spy)
+    # (the command imports micro.api's function when it runs, after its checks)
+    monkeypatch.setattr(micro.api, "critical_velocity", spy)
     out = tmp_path / "vc.csv"
     assert cli.main(["critical", "--k0", "0.3", "--k1", "0.2", "--k2", "0.7", "--method", "fp", "--eps", "0.02",
                      "--rel-tol", "0.3", "--V-min", "0.02", "--no-refine", "--rtol", "0.005", "--out", str(out)]) == 0
@@ -98,7 +101,7 @@ def test_cli_critical_fp_options_reach_the_bisection(tmp_path, monkeypatch):
     assert (model.k0, model.k1, model.k2) == (0.3, 0.2, 0.7)
     assert kw["method"] == "fp" and kw["refine"] is False and kw["numerics"].eps == 0.02
     assert kw["rel_tol"] == 0.3 and kw["V_min"] == 0.02 and kw["convergence"].rtol == 0.005
-    assert pd.read_csv(out).Vc.iloc[0] == pytest.approx(micro.critical_velocity(model).Vc, rel=1e-12)
+    assert pd.read_csv(out).Vc.iloc[0] == pytest.approx(direct(model).Vc, rel=1e-12)
 
 
 def test_cli_model_options_reach_the_model(tmp_path):
