@@ -9,7 +9,7 @@ Each says which internal it wraps; the internal's own docstring is the reference
 
 Cohort method (:mod:`micro.cohort`)
     ``CohortState`` (the state: cohorts, time, slip, stress), ``NO_COARSE``,
-    ``start_state``, ``continued``, ``one_cycle``, ``phase_step``, ``step_off``,
+    ``start_state``, ``continued``, ``one_cycle``, ``fold_start``, ``phase_step``, ``step_off``,
     ``relaxation_multiplier``, ``error_estimate``, ``state_tail``, ``product_cycle``,
     ``carried_cycle``, ``support``, ``newton_krylov``, ``NEWTON_FD_STEP``, ``gauss_rule``.
 Renewal chain (:mod:`micro.renewal`)
@@ -29,7 +29,7 @@ from .cohort import cycle as _cycle, estimate as _estimate, options as _options,
 from .params import Model
 
 __all__ = [
-    "CohortState", "NO_COARSE", "start_state", "continued", "one_cycle", "phase_step", "step_off",
+    "CohortState", "NO_COARSE", "start_state", "continued", "one_cycle", "fold_start", "phase_step", "step_off",
     "relaxation_multiplier", "error_estimate", "state_tail", "product_cycle", "carried_cycle",
     "support", "map_multipliers", "newton_krylov", "NEWTON_FD_STEP", "gauss_rule",
     "quadrature", "map_width", "chain_grid", "chain_on_grid", "waiting_time",
@@ -63,6 +63,12 @@ def one_cycle(state: _state._Cohorts, step: float) -> dict:
     """For studies: one cycle of the cohort map from ``state`` (changed in place) with
     loading steps ``step``; its extrema, period and unjumped fraction (``micro.cohort.cycle._one_cycle``)."""
     return _cycle._one_cycle(state, step)
+
+
+def fold_start(state: _state._Cohorts, step: float) -> tuple[float, float]:
+    """For studies: where in a step of ``step`` from ``state`` that starts a shock the fold
+    appears, as (the longest part without a fold, its slip) (``micro.cohort.cycle._fold_start``)."""
+    return _cycle._fold_start(state, step)
 
 
 def phase_step(period: float, dt: float) -> float:

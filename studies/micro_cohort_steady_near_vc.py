@@ -68,22 +68,12 @@ def _step(st, length: float) -> int:
         return 0
     if status == 2:
         raise RuntimeError(f"the closure did not converge at t = {st.t:.4g}")
-    lo, hi, x_lo = 0.0, length, 0.0
-    while hi - lo > 1e-7 * length:
-        mid = 0.5 * (lo + hi)
-        st.prepare(mid)
-        x, s = st.root(below=x_lo)
-        if s == 0:
-            lo, x_lo = mid, x
-        else:
-            hi = mid
+    lo, x_lo = hooks.fold_start(st, length)
     if lo > 0.0:
         phi, Edt = st.prepare(lo)
         x, _ = st.root(below=x_lo)
         st.commit(x, lo, phi, Edt)
-    st.prepare(0.0)
-    x0, _ = st.root()
-    st.commit(st.shock_root(max(x0, 1e-12 * st.model.zbar)), 0.0, 0.0, 1.0)
+    st.shock()
     return 1
 
 
@@ -177,15 +167,18 @@ def fold_flips(k0: float, d: float, dt: float, h_div: float, cycles: int) -> lis
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m studies micro_cohort_steady_near_vc", description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(prog="python -m studies micro_cohort_steady_near_vc",
+                                description=__doc__.split("\n\n")[0])
     p.add_argument("--k0", type=float, default=0.01)
     p.add_argument("--fraction", type=float, default=1.1, help="V / V^c, above 1 (default 1.1)")
     p.add_argument("--steps", default="0.002,0.001", help="uniform time steps, comma-separated")
     p.add_argument("--h-div", default="20", help="cells kappa zbar / H, comma-separated")
     p.add_argument("--duration", type=float, default=16.0)
     p.add_argument("--every", type=float, default=2.0)
-    p.add_argument("--trial", type=float, default=1.5, help="a trial step this many times the step at the end (0: none)")
-    p.add_argument("--cycle-d", type=float, default=None, help="instead: the folds at the shocks' starts of cold cycles at this d")
+    p.add_argument("--trial", type=float, default=1.5,
+                   help="a trial step this many times the step at the end (0: none)")
+    p.add_argument("--cycle-d", type=float, default=None,
+                   help="instead: the folds at the shocks' starts of cold cycles at this d")
     p.add_argument("--cycle-dt", type=float, default=0.02)
     p.add_argument("--cycles", type=int, default=30)
     a = p.parse_args(argv)

@@ -166,6 +166,23 @@ def _one_cycle(st: _Cohorts, dt: float) -> dict:
         return _one_cycle_steps(st, dt, t_start, sigma_start, t_max)
 
 
+def _fold_start(st: _Cohorts, step: float) -> tuple[float, float]:
+    """Where in a step of ``step`` that starts a shock the fold appears: the step bisected
+    to FOLD_TOL of its length, as (the longest part found without a fold, its slip); 0 and
+    0 if the fold is at the step's start.  Leaves ``st`` prepared for a part of the step."""
+    opt = options.DEFAULT
+    lo, hi, x_lo = 0.0, step, 0.0
+    while hi - lo > opt.FOLD_TOL * step:
+        mid = 0.5 * (lo + hi)
+        st.prepare(mid)
+        x, status = st.root(below=x_lo)  # (a longer step slips more)
+        if status == 0:
+            lo, x_lo = mid, x
+        else:
+            hi = mid
+    return lo, x_lo
+
+
 def _one_cycle_steps(st: _Cohorts, dt: float, t_start: float, sigma_start: float, t_max: float) -> dict:
     """The steps of :func:`_one_cycle` (within its progress stage)."""
     opt = options.DEFAULT
@@ -200,15 +217,7 @@ def _one_cycle_steps(st: _Cohorts, dt: float, t_start: float, sigma_start: float
             advance(x, step, phi, Edt)
             continue
         here = st.copy() if replay and snapshot is None else None
-        lo, hi, x_lo = 0.0, step, 0.0
-        while hi - lo > opt.FOLD_TOL * step:
-            mid = 0.5 * (lo + hi)
-            st.prepare(mid)
-            x, status = st.root(below=x_lo)  # (a longer step slips more)
-            if status == 0:
-                lo, x_lo = mid, x
-            else:
-                hi = mid
+        lo, x_lo = _fold_start(st, step)
         if lo > 0.0:
             phi, Edt = st.prepare(lo)
             x, _ = st.root(below=x_lo)
@@ -221,13 +230,10 @@ def _one_cycle_steps(st: _Cohorts, dt: float, t_start: float, sigma_start: float
     sigma_before, period = st.sigma, st.t - t_start
     if abs(period - st.period_ref) > opt.GRADED_SLACK / gamma:
         st.period_ref = period
-    st.prepare(0.0)
-    x, _ = st.root()
     try:
-        slip = st.shock_root(max(x, 1e-12 * st.model.zbar))
+        slip = st.shock()
     except RuntimeError as err:
         return dict(ok=False, message=str(err))
-    st.commit(slip, 0.0, 0.0, 1.0)
     steps.append((0.0, slip))
     cell = st.cell_masses()
     # (the shock's newborns are the last cohort; not counted by index from before the

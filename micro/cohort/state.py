@@ -241,6 +241,16 @@ class _Cohorts:
         self.sigma += md.k0 * (self.V * dt - dX)
         self.add(dep, opt.AGE * dt)
 
+    def shock(self) -> float:
+        """Apply the shock that starts now (the closure in zero time, run to its root beyond
+        its positive minimum: :meth:`shock_root`) and return its slip; RuntimeError if the
+        closure has no root."""
+        self.prepare(0.0)
+        x, _ = self.root()
+        slip = self.shock_root(max(x, 1e-12 * self.model.zbar))
+        self.commit(slip, 0.0, 0.0, 1.0)
+        return slip
+
     def shock_root(self, x0: float) -> float:
         """The slip of the shock: the closure's root beyond its positive minimum (after
         :meth:`prepare` with dt = 0), bracketed by doubling, bisected to a hundredth,
