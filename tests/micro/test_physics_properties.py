@@ -120,6 +120,7 @@ def _same_weakening(a, b, f_th: float) -> None:
 @SCALING
 @given(model=MODELS, shift=st.floats(-0.4, 2.0))
 def test_f_th_shifts_the_stress_and_leaves_vc(model, shift):
+    assume(_positive_fast_friction(model.f_th + shift, model.kappa, model.zbar))
     moved = dataclasses.replace(model, f_th=model.f_th + shift)
     V = _velocities(model)
     _same_vc(_vc(moved), _vc(model))
