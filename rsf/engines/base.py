@@ -78,30 +78,28 @@ class Stop(Exception):
 
 @dataclass
 class Samples:
-    """The recorded time series, in pieces (one array per call of :meth:`add`)."""
+    """The recorded time series, in pieces: one tuple of arrays (t, x, sigma, theta, v and,
+    with a second state variable, theta2) per call of :meth:`add`, stored by one append, so
+    that a Ctrl-C arriving inside :meth:`add` leaves every series the same length (with one
+    list per series it could leave ``t`` a piece longer than the others, and the samples
+    kept after the interrupt then failed to be written)."""
 
-    t: list = field(default_factory=list)
-    x: list = field(default_factory=list)
-    sigma: list = field(default_factory=list)
-    theta: list = field(default_factory=list)
-    v: list = field(default_factory=list)
-    theta2: list = field(default_factory=list)    # the second state variable, if any
+    pieces: list = field(default_factory=list)
 
     def add(self, t, x, sigma, theta, v, theta2=None) -> None:
-        self.t.append(np.atleast_1d(np.array(t, dtype=float, copy=True)))
-        n = self.t[-1].size
-        for name, val in (("x", x), ("sigma", sigma), ("theta", theta), ("v", v)):
-            getattr(self, name).append(np.broadcast_to(np.asarray(val, dtype=float), (n,)).copy())
-        if theta2 is not None:
-            self.theta2.append(np.broadcast_to(np.asarray(theta2, dtype=float), (n,)).copy())
+        t = np.atleast_1d(np.array(t, dtype=float, copy=True))
+        extra = () if theta2 is None else (theta2,)
+        self.pieces.append((t, *(np.broadcast_to(np.asarray(val, dtype=float), (t.size,)).copy()
+                                  for val in (x, sigma, theta, v, *extra))))
 
     def theta2_array(self) -> np.ndarray:
-        return np.concatenate(self.theta2) if self.theta2 else np.empty(0)
+        parts = [p[5] for p in self.pieces if len(p) > 5]
+        return np.concatenate(parts) if parts else np.empty(0)
 
     def arrays(self) -> tuple[np.ndarray, ...]:
-        if not self.t:
+        if not self.pieces:
             return tuple(np.empty(0) for _ in range(5))
-        return tuple(np.concatenate(getattr(self, name)) for name in ("t", "x", "sigma", "theta", "v"))
+        return tuple(np.concatenate([p[i] for p in self.pieces]) for i in range(5))
 
 
 class Engine:

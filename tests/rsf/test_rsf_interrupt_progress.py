@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from _interrupting import ROOT, interrupt_after  # noqa: E402
@@ -94,3 +95,19 @@ def test_simulate_that_needs_too_many_events_stops_early_with_its_projection():
     m = re.search(r"t_end = 1000 needs about (\S+) events, more than max_events = 2000000", run.message)
     assert m, run.message
     assert 2e7 < float(m.group(1)) < 1e8
+
+
+def test_a_ctrl_c_inside_a_sample_leaves_every_series_the_same_length():
+    # CI once failed here: rsf run interrupted while its engine stored a sample wrote
+    # "error: All arrays must be of the same length" and exited 2, losing the samples kept
+    from rsf.engines.base import Samples
+
+    class CtrlC:
+        def __array__(self, *args, **kwargs):
+            raise KeyboardInterrupt
+
+    samples = Samples()
+    samples.add([0.0, 1.0], 0.5, 0.6, 0.7, 0.8)
+    with pytest.raises(KeyboardInterrupt):
+        samples.add([2.0, 3.0], 0.5, 0.6, 0.7, CtrlC())
+    assert {a.size for a in samples.arrays()} == {2}
