@@ -265,6 +265,9 @@ def warm_up() -> float:
     start = time.perf_counter()
     rs_curves([0.1], lambda k0: rsf.HyperbolicLaw(), 0.06, V_range=lambda k0: (0.5, 5.0), n=4)
     law = rsf.HyperbolicLaw().bind(0.1)
-    rs_slide_hold_slide(classical_rs(law, 1.0, 0.02, 0.1, 0.06), 1.0, [1.0])
+    # (D_c = 0.3: stiffer than critical, (b - a) / D_c = 0.02 < k0, so the reload after the hold
+    # does not run away and the warm-up logs nothing; at D_c = 0.06 it was exactly critical and
+    # every report printed a 'runaway slip' warning of its own warm-up)
+    rs_slide_hold_slide(classical_rs(law, 1.0, 0.02, 0.1, 0.3), 1.0, [1.0])
     rs_slide_hold_slide(rsf.SpringSlider(k0=0.1), 1.0, [1.0])
     return time.perf_counter() - start

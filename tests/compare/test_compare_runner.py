@@ -310,3 +310,15 @@ def test_every_warm_up_group_brings_kernels_of_its_own():
     assert out.returncode == 0, out.stderr[-2000:]
     added = {line.split()[1]: int(line.split()[2]) for line in out.stdout.splitlines() if line.startswith("GROUP")}
     assert added and min(added.values()) > 0, added
+
+
+def test_rsf_warm_up_logs_nothing(caplog):
+    # the warm-up runs in a thread beside the pool; a warning of its own tiny runs reached every
+    # report's stderr, and after a SIGTERM it could be the last line, after "interrupted:"
+    import logging
+
+    from compare import rs_side
+
+    with caplog.at_level(logging.INFO):
+        rs_side.warm_up()
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING], caplog.text

@@ -60,9 +60,14 @@ def _positive_fast_friction(f_th, kappa, zbar):
     return f_th > 1.05 * kappa * zbar
 
 
-def _model(k0, k1, k2, eta_u, f_th, zbar):
-    assume(_positive_fast_friction(f_th, k0 + k1 + k2, zbar))
+def _valid_model(k0, k1, k2, eta_u, f_th, zbar):
     return micro.Model(k0=k0, k1=k1, k2=k2, eta_u=eta_u, f_th=f_th, jumps=micro.Exponential(zbar, 100.0 * zbar))
+
+
+def _model(k0, k1, k2, eta_u, f_th, zbar):
+    # (drawn only: assume() belongs inside a property; the fixed @example uses _valid_model)
+    assume(_positive_fast_friction(f_th, k0 + k1 + k2, zbar))
+    return _valid_model(k0, k1, k2, eta_u, f_th, zbar)
 
 
 #: cheap models: k0 >= 0.02 (the chain's cost and V^c's conditioning grow as k0 falls), both
@@ -75,7 +80,7 @@ FACTOR = st.floats(0.25, 4.0)
 # ------------------------------------------------------------------------------ the reference
 @FEW
 @given(model=MODELS)
-@example(model=_model(k0=0.4375, k1=0.0, k2=0.5, eta_u=1.0, f_th=1.0, zbar=0.25))  # (the reference's secant, fixed)
+@example(model=_valid_model(k0=0.4375, k1=0.0, k2=0.5, eta_u=1.0, f_th=1.0, zbar=0.25))  # (the reference's secant, fixed)
 def test_steady_sliding_and_critical_velocity_meet_the_independent_reference(model):
     # V^c to 1e-9, sigma to 1e-12 and b to 1e-12 at 0.5 and 3 V^c (V = 0.03 and 3 without
     # stick-slip): tests/micro/test_renewal_independent.py's _tolerances
