@@ -169,11 +169,13 @@ class PeriodicChain:
         b = np.zeros(n * m)
         b[0] = 1.0
         pi = spla.spsolve(A.tocsc(), b) * (L / z)  # jumps per block per period
-        jumps = pi.reshape(n, m).sum(axis=1)
-        pe = pi.reshape(n, m).sum(axis=0)
+        by_state = pi.reshape(n, m)
+        jumps = by_state.sum(axis=1)
+        pe = by_state.sum(axis=0)
         held = np.nonzero(pe > 1e-9 * pe.max())[0]
-        return dict(jumps=jumps, e_support=(self.egrid[held[0]], self.egrid[held[-1]]), slip_error=jumps * z - hs, sigma0=mo.f_th - float(pi @ delta0),
-                    lost=float(lost.max()), clipped=float(pi @ clipped) * z / L)
+        return dict(jumps=jumps, slip_error=jumps * z - hs, sigma0=mo.f_th - float(pi @ delta0),
+                    e_support=(self.egrid[held[0]], self.egrid[held[-1]]), lost=float(lost.max()),
+                    clipped=float(pi @ clipped) * z / L)
 
 
 def layout(u: np.ndarray, n_l: int, n_s: int, V: float) -> tuple[np.ndarray, np.ndarray]:
